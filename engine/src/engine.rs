@@ -1,0 +1,1030 @@
+//! The compiled model and its simulation: flat arrays grouped by element kind, run sample by
+//! sample in the stage order of spec §1.5.
+//!
+//! Lifecycle: [`crate::compile`] (allocates, off the audio thread) → [`Engine::process`] /
+//! [`Engine::set_param`] / [`Engine::reset`] (realtime: no allocation, lock, log or I/O) → drop
+//! (off the audio thread).
+//!
+//! Layout of the point arrays (`x`, `xp`, `f`), which is also the generic motion-buffer order of
+//! spec §6.2 for the first three ranges:
+//!
+//! ```text
+//! [ single mass-type elements | macro nodes, macro by macro | avatars | connection points ]
+//! ```
+//!
+//! Stage 2 a runs one loop over the first range with per-point coefficients (a ground is the
+//! M → ∞ limit: a = 1, b = 0, 1/M = 0, so it never moves and needs no branch). Each macro kind has
+//! its own stencil kernel. Each interaction law has its own loop over endpoint index arrays.
+//! Names never reach this module's hot paths; there is no per-element `match`.
+
+use crate::expr::{ExprRef, Program};
+use crate::info::ModelInfo;
+use crate::laws;
+use crate::motion::MotionStore;
+use crate::spec::ScaleClass;
+use std::sync::Arc;
+
+/// The position state of every point (spec §1.2): x, the delayed position x̃ and the force
+/// accumulator F. Units: model units and per-step forces. Touched only by the audio thread.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Points {
+    pub x: Vec<f64>,
+    pub xp: Vec<f64>,
+    pub f: Vec<f64>,
+}
+
+/// Stage 2 a: single mass-type elements, points `0..len`.
+///
+/// X[n+1] = a·X[n] + b·X[n−1] + (F − g)·(1/M), with a = 2 − (K+Z)/M and b = Z/M − 1 (spec
+/// §2.1.2; K = Z = 0 for `mass`, which gives 2X − X̃ + (F − g)/M, spec §2.1.1).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SingleMasses {
+    pub a: Vec<f64>,
+    pub b: Vec<f64>,
+    pub inv_m: Vec<f64>,
+    /// Per-step gravity force g (subtracted from F).
+    pub gravity: Vec<f64>,
+    /// Grounds: never move (cold, used by `derive`).
+    pub fixed: Vec<bool>,
+    /// Argument columns in `Engine::args`: M, K, Z, gravity.
+    pub cols: [usize; 4],
+}
+
+impl SingleMasses {
+    pub fn len(&self) -> usize {
+        self.a.len()
+    }
+
+    /// Recomputes the coefficients of point `i` from its arguments.
+    #[inline]
+    pub fn derive(&mut self, i: usize, args: &[f64]) {
+        if self.fixed[i] {
+            self.a[i] = 1.0;
+            self.b[i] = 0.0;
+            self.inv_m[i] = 0.0;
+            self.gravity[i] = 0.0;
+            return;
+        }
+        let m = args[self.cols[0] + i];
+        let k = args[self.cols[1] + i];
+        let z = args[self.cols[2] + i];
+        self.a[i] = 2.0 - (k + z) / m;
+        self.b[i] = z / m - 1.0;
+        self.inv_m[i] = 1.0 / m;
+        self.gravity[i] = args[self.cols[3] + i];
+    }
+
+    #[inline]
+    fn step(&self, p: &mut Points) {
+        let n = self.len();
+        let (x, xp, f) = (&mut p.x[..n], &mut p.xp[..n], &mut p.f[..n]);
+        for i in 0..n {
+            let next =
+                self.a[i] * x[i] + self.b[i] * xp[i] + (f[i] - self.gravity[i]) * self.inv_m[i];
+            xp[i] = x[i];
+            x[i] = next;
+            f[i] = 0.0;
+        }
+    }
+}
+
+/// The argument slots of one macro in `Engine::args`: M, K, K2 (stiff strings), Z, Zo.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct MacroSlots {
+    pub m: usize,
+    pub k: usize,
+    pub k2: usize,
+    pub z: usize,
+    pub zo: usize,
+}
+
+/// A string, chain or stiff string occupying points `base..base+len`.
+#[derive(Clone, Debug)]
+pub(crate) struct LineMacro {
+    pub base: usize,
+    pub len: usize,
+    /// Strings and stiff strings: nodes 0 and N−1 never move.
+    pub fixed_ends: bool,
+    pub slots: MacroSlots,
+}
+
+/// A mesh of `length × width` nodes at `base..`, node index i·W + j (spec §2.7.4).
+#[derive(Clone, Debug)]
+pub(crate) struct MeshMacro {
+    pub base: usize,
+    pub length: usize,
+    pub width: usize,
+    /// Local indices of pinned nodes (corners or border).
+    pub pinned: Vec<u32>,
+    pub slots: MacroSlots,
+}
+
+/// The per-step coefficients of the ground-friction node law of spec §2.7:
+/// X[n+1] = (2 − Zo/M)·X + (Zo/M − 1)·X̃ + F/M.
+#[inline(always)]
+fn node_law(m: f64, zo: f64) -> (f64, f64, f64) {
+    let zm = zo / m;
+    (2.0 - zm, zm - 1.0, 1.0 / m)
+}
+
+/// Stage 2 b: all macro structures. Each updates its nodes, then adds its internal forces.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Macros {
+    pub lines: Vec<LineMacro>,
+    pub stiff: Vec<LineMacro>,
+    pub meshes: Vec<MeshMacro>,
+    /// Node velocities x − x̃ of the macro being computed (sized for the largest macro).
+    pub scratch_v: Vec<f64>,
+    /// Link forces of the macro being computed.
+    pub scratch_s: Vec<f64>,
+}
+
+impl Macros {
+    fn step(&mut self, p: &mut Points, args: &[f64]) {
+        let (v, s) = (&mut self.scratch_v, &mut self.scratch_s);
+        for mac in &self.lines {
+            let range = mac.base..mac.base + mac.len;
+            let x = &mut p.x[range.clone()];
+            let xp = &mut p.xp[range.clone()];
+            let f = &mut p.f[range];
+            update_line_nodes(mac, x, xp, f, args);
+            chain_links(x, xp, f, v, s, args[mac.slots.k], args[mac.slots.z]);
+        }
+        for mac in &self.stiff {
+            let range = mac.base..mac.base + mac.len;
+            let x = &mut p.x[range.clone()];
+            let xp = &mut p.xp[range.clone()];
+            let f = &mut p.f[range];
+            update_line_nodes(mac, x, xp, f, args);
+            chain_links(x, xp, f, v, s, args[mac.slots.k], args[mac.slots.z]);
+            stiffness_links(x, f, args[mac.slots.k2]);
+        }
+        for mac in &self.meshes {
+            let n = mac.length * mac.width;
+            let range = mac.base..mac.base + n;
+            let x = &mut p.x[range.clone()];
+            let xp = &mut p.xp[range.clone()];
+            let f = &mut p.f[range];
+            mesh_step(mac, x, xp, f, v, s, args);
+        }
+    }
+}
+
+/// Moves the nodes of a line macro with the node law; fixed ends keep x = x̃ = X₀. Every
+/// node's force is reset.
+#[inline]
+fn update_line_nodes(mac: &LineMacro, x: &mut [f64], xp: &mut [f64], f: &mut [f64], args: &[f64]) {
+    let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
+    let n = x.len();
+    let (lo, hi) = if mac.fixed_ends {
+        (1, n.saturating_sub(1))
+    } else {
+        (0, n)
+    };
+    for i in lo..hi {
+        let next = a * x[i] + b * xp[i] + f[i] * inv_m;
+        xp[i] = x[i];
+        x[i] = next;
+    }
+    f.fill(0.0);
+}
+
+/// The N−1 spring-dampers (i, i+1) of a line macro (spec §2.7.1–§2.7.3). The node forces are
+/// zero on entry, so F_i = (0 + s_{i−1}) − s_i: the same sum, in the same order, as applying the
+/// links one by one in script order.
+#[inline]
+fn chain_links(x: &[f64], xp: &[f64], f: &mut [f64], v: &mut [f64], s: &mut [f64], k: f64, z: f64) {
+    let n = x.len();
+    if n < 2 {
+        return;
+    }
+    let v = &mut v[..n];
+    for i in 0..n {
+        v[i] = x[i] - xp[i];
+    }
+    let s = &mut s[..n - 1];
+    for i in 0..n - 1 {
+        s[i] = laws::spring_damper(x[i] - x[i + 1], v[i] - v[i + 1], k, z);
+    }
+    f[0] = -s[0];
+    for i in 1..n - 1 {
+        f[i] = s[i - 1] - s[i];
+    }
+    f[n - 1] = s[n - 2];
+}
+
+/// The stiff string's undamped K₂ springs (spec §2.7.3): f = K₂(x_a − x_b) for
+/// a = clip(i, 0, N−1), b = clip(i+2, 0, N−1), i = −1..N−1, applied in that order.
+#[inline]
+fn stiffness_links(x: &[f64], f: &mut [f64], k2: f64) {
+    let n = x.len() as isize;
+    for i in -1..n {
+        let a = i.clamp(0, n - 1) as usize;
+        let b = (i + 2).clamp(0, n - 1) as usize;
+        let t = k2 * (x[a] - x[b]);
+        f[a] -= t;
+        f[b] += t;
+    }
+}
+
+/// One step of a mesh (spec §2.7.4): every node moves with the node law; pinned nodes are then
+/// reset to x = x̃ = x_edge (node 0's position before the update) with F = 0; then the links
+/// (i,j)–(i,j+1) for all rows, then (i,j)–(i+1,j).
+#[inline]
+fn mesh_step(
+    mac: &MeshMacro,
+    x: &mut [f64],
+    xp: &mut [f64],
+    f: &mut [f64],
+    v: &mut [f64],
+    s: &mut [f64],
+    args: &[f64],
+) {
+    let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
+    let (k, z) = (args[mac.slots.k], args[mac.slots.z]);
+    let (len, w) = (mac.length, mac.width);
+    let n = len * w;
+    let x_edge = x[0];
+    for i in 0..n {
+        let next = a * x[i] + b * xp[i] + f[i] * inv_m;
+        xp[i] = x[i];
+        x[i] = next;
+    }
+    for &p in &mac.pinned {
+        x[p as usize] = x_edge;
+        xp[p as usize] = x_edge;
+    }
+    let v = &mut v[..n];
+    for i in 0..n {
+        v[i] = x[i] - xp[i];
+    }
+    // Links along the width, row by row. F is zero on entry (as in `chain_links`).
+    for row in 0..len {
+        let r = row * w;
+        let (xr, vr, fr) = (&x[r..r + w], &v[r..r + w], &mut f[r..r + w]);
+        let sr = &mut s[..w - 1];
+        for j in 0..w - 1 {
+            sr[j] = laws::spring_damper(xr[j] - xr[j + 1], vr[j] - vr[j + 1], k, z);
+        }
+        fr[0] = -sr[0];
+        for j in 1..w - 1 {
+            fr[j] = sr[j - 1] - sr[j];
+        }
+        fr[w - 1] = sr[w - 2];
+    }
+    // Links along the length: (n, n + W) for n < (L−1)·W. Node n receives +s[n−W] before
+    // −s[n], as in script order.
+    let m = (len - 1) * w;
+    let s = &mut s[..m];
+    for i in 0..m {
+        s[i] = laws::spring_damper(x[i] - x[i + w], v[i] - v[i + w], k, z);
+    }
+    for i in 0..w.min(m) {
+        f[i] -= s[i];
+    }
+    for i in w..m {
+        f[i] = f[i] + s[i - w] - s[i];
+    }
+    for i in m.max(w)..n {
+        f[i] += s[i - w];
+    }
+}
+
+/// Connection points (spec §2.8), points `base..base+len`: massless points interpolated from up
+/// to four macro nodes, whose force is spread back with the same weights.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Proxies {
+    pub base: usize,
+    pub nodes: Vec<[u32; 4]>,
+    pub weights: Vec<[f64; 4]>,
+    /// The macro each proxy addresses: first node, length and width (width 0 for 1-D).
+    pub geometry: Vec<(u32, u32, u32)>,
+    /// Argument slots of the coordinates (α, or u and w).
+    pub coord_slots: Vec<[usize; 2]>,
+}
+
+impl Proxies {
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Recomputes the nodes and weights of proxy `i` from its coordinates (spec §2.8).
+    pub fn derive(&mut self, i: usize, args: &[f64]) {
+        /// Clamped position along `n` nodes: (lower node, upper node, fraction).
+        fn along(c: f64, n: u32) -> (u32, u32, f64) {
+            let last = n.saturating_sub(1);
+            // NaN coordinates count as 0.
+            let c = if c >= 0.0 { c.min(1.0) } else { 0.0 };
+            let p = c * last as f64;
+            let lo = (p.floor() as u32).min(last);
+            let hi = (lo + 1).min(last);
+            (lo, hi, p - lo as f64)
+        }
+        let (base, length, width) = self.geometry[i];
+        let [s0, s1] = self.coord_slots[i];
+        if width == 0 {
+            let (m1, m2, a) = along(args[s0], length);
+            self.nodes[i] = [base + m1, base + m2, base + m1, base + m1];
+            self.weights[i] = [1.0 - a, a, 0.0, 0.0];
+        } else {
+            let (i1, i2, ai) = along(args[s0], length);
+            let (j1, j2, aj) = along(args[s1], width);
+            let node = |i: u32, j: u32| base + i * width + j;
+            self.nodes[i] = [node(i1, j1), node(i2, j1), node(i1, j2), node(i2, j2)];
+            self.weights[i] = [
+                (1.0 - ai) * (1.0 - aj),
+                ai * (1.0 - aj),
+                (1.0 - ai) * aj,
+                ai * aj,
+            ];
+        }
+    }
+
+    /// Stage 3: x̃_P ← x_P, x_P ← Σ w·x_node. The force slot is cleared here, after stage 6 of
+    /// the previous step read it (it holds F_P for `frcOutput`, spec §3.12 e).
+    #[inline]
+    fn update_positions(&self, p: &mut Points) {
+        for i in 0..self.len() {
+            let [n0, n1, n2, n3] = self.nodes[i];
+            let [w0, w1, w2, w3] = self.weights[i];
+            let x = &p.x;
+            let pos = w0 * x[n0 as usize]
+                + w1 * x[n1 as usize]
+                + w2 * x[n2 as usize]
+                + w3 * x[n3 as usize];
+            let k = self.base + i;
+            p.xp[k] = p.x[k];
+            p.x[k] = pos;
+            p.f[k] = 0.0;
+        }
+    }
+
+    /// Stage 5: spread F_P onto the macro nodes, in creation order.
+    #[inline]
+    fn spread_forces(&self, p: &mut Points) {
+        for i in 0..self.len() {
+            let fp = p.f[self.base + i];
+            let nodes = self.nodes[i];
+            let weights = self.weights[i];
+            for (n, w) in nodes.iter().zip(weights) {
+                p.f[*n as usize] += w * fp;
+            }
+        }
+    }
+}
+
+/// Interactions of one law: endpoint index arrays and argument columns in `Engine::args`
+/// (column c of row i is `args[cols[c] + i]`).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Group {
+    pub a: Vec<u32>,
+    pub b: Vec<u32>,
+    pub cols: Vec<usize>,
+}
+
+impl Group {
+    pub fn len(&self) -> usize {
+        self.a.len()
+    }
+
+    #[inline(always)]
+    fn col<'a>(&self, args: &'a [f64], c: usize) -> &'a [f64] {
+        &args[self.cols[c]..self.cols[c] + self.len()]
+    }
+
+    /// Applies `law(i, Δx, Δv)` to every pair with the convention of spec §1.3:
+    /// F₁ −= f, F₂ += f.
+    #[inline(always)]
+    fn apply(&self, p: &mut Points, law: impl Fn(usize, f64, f64) -> f64) {
+        for i in 0..self.len() {
+            let (ia, ib) = (self.a[i] as usize, self.b[i] as usize);
+            let dx = p.x[ia] - p.x[ib];
+            let dv = (p.x[ia] - p.xp[ia]) - (p.x[ib] - p.xp[ib]);
+            let f = law(i, dx, dv);
+            p.f[ia] -= f;
+            p.f[ib] += f;
+        }
+    }
+}
+
+/// Stage 4: every interaction, one loop per law.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Interactions {
+    /// spring, damper, springDamper: (K, Z).
+    pub linear: Group,
+    /// (K, Z, θ).
+    pub contact: Group,
+    /// (s, c, k, Z, θ).
+    pub nl_contact: Group,
+    /// (K, Q, Z).
+    pub nl_spring2: Group,
+    /// (K, Q, Z).
+    pub nl_spring3: Group,
+    /// (s, c, k, Z).
+    pub nl_spring_damper: Group,
+    /// (K, scale, Z).
+    pub pluck: Group,
+    /// (Z, scale, smooth).
+    pub bow: Group,
+}
+
+impl Interactions {
+    #[inline]
+    fn step(&self, p: &mut Points, args: &[f64]) {
+        let g = &self.linear;
+        let (k, z) = (g.col(args, 0), g.col(args, 1));
+        g.apply(p, |i, dx, dv| laws::spring_damper(dx, dv, k[i], z[i]));
+
+        let g = &self.contact;
+        let (k, z, t) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+        g.apply(p, |i, dx, dv| laws::contact(dx, dv, k[i], z[i], t[i]));
+
+        let g = &self.nl_contact;
+        let (s, c, k, z, t) = (
+            g.col(args, 0),
+            g.col(args, 1),
+            g.col(args, 2),
+            g.col(args, 3),
+            g.col(args, 4),
+        );
+        g.apply(p, |i, dx, dv| {
+            laws::nl_contact(dx, dv, s[i], c[i], k[i], z[i], t[i])
+        });
+
+        let g = &self.nl_spring2;
+        let (k, q, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+        g.apply(p, |i, dx, dv| laws::nl_spring2(dx, dv, k[i], q[i], z[i]));
+
+        let g = &self.nl_spring3;
+        let (k, q, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+        g.apply(p, |i, dx, dv| laws::nl_spring3(dx, dv, k[i], q[i], z[i]));
+
+        let g = &self.nl_spring_damper;
+        let (s, c, k, z) = (
+            g.col(args, 0),
+            g.col(args, 1),
+            g.col(args, 2),
+            g.col(args, 3),
+        );
+        g.apply(p, |i, dx, dv| {
+            laws::nl_spring_damper(dx, dv, s[i], c[i], k[i], z[i])
+        });
+
+        let g = &self.pluck;
+        let (k, sc, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+        g.apply(p, |i, dx, dv| laws::nl_pluck(dx, dv, k[i], sc[i], z[i]));
+
+        let g = &self.bow;
+        let (z, sc, sm) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+        g.apply(p, |i, _dx, dv| laws::nl_bow(dv, z[i], sc[i], sm[i]));
+    }
+}
+
+/// A signal routed between a 0-based channel and a point or parameter slot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Route {
+    pub channel: u32,
+    pub index: u32,
+}
+
+/// The classes an argument's value is multiplied by: spec §1.7 plus two internal ones.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ArgClass {
+    None = 0,
+    Stiffness = 1,
+    Damping = 2,
+    Gravity = 3,
+    /// `massG` gravity: ×(44100/SR)², not divided by 44100 (spec §2.1.4).
+    LegacyGravity = 4,
+    /// The bow's Vscale: a per-step velocity, SR-scaled like Z but not a damping, so the host's
+    /// damping gain leaves it alone.
+    VelocityScale = 5,
+}
+
+pub(crate) const NUM_ARG_CLASSES: usize = 6;
+
+/// One argument: its slot in `Engine::args` receives `program(expr) × class factor`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Binding {
+    pub slot: u32,
+    pub expr: ExprRef,
+    pub class: ArgClass,
+}
+
+/// How a point's initial state is computed at stage 0 (spec §1.5).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum InitRule {
+    /// x = x̃ = X₀ (grounds, avatars, fixed nodes).
+    Fixed,
+    /// x̃ = X₀ − v·factor (factor 1/SR scaled, 1 raw).
+    Velocity { v: ExprRef, factor: f64 },
+    /// massG: x̃ = X₀ − (X₀ − X_R0)·factor (factor 44100/SR scaled, 1 raw).
+    Delayed { xr0: ExprRef, factor: f64 },
+}
+
+/// The initial state of a run of points `first..first+count` that share X₀ and a rule.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct InitRun {
+    pub first: u32,
+    pub count: u32,
+    pub x0: ExprRef,
+    pub rule: InitRule,
+}
+
+/// What the runtime guard saw (spec §3.12 f; issue: stability guard).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GuardEvent {
+    /// The sample, counted from the last reset, at which the problem was seen.
+    pub sample: u64,
+    pub kind: GuardKind,
+    /// The point (index in [`ModelInfo::points`], or a connection point beyond them) whose
+    /// position went bad, when known.
+    pub point: Option<u32>,
+    /// The output channel (0-based) that went bad, when it was an output.
+    pub output: Option<u32>,
+}
+
+/// Why the guard tripped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GuardKind {
+    /// A position or output became NaN or infinite.
+    NonFinite,
+    /// A position or output exceeded [`Engine::position_limit`].
+    Runaway,
+}
+
+/// The default runaway limit on positions and outputs, in model units. Reference models move
+/// by less than a few units.
+pub const DEFAULT_POSITION_LIMIT: f64 = 1.0e4;
+
+/// A compiled model and its running state. Built by [`crate::compile`].
+#[derive(Debug)]
+pub struct Engine {
+    pub(crate) info: ModelInfo,
+
+    // Hot state.
+    pub(crate) points: Points,
+    /// Per-step argument values (after scaling and class gains), column by column.
+    pub(crate) args: Vec<f64>,
+    pub(crate) singles: SingleMasses,
+    pub(crate) macros: Macros,
+    pub(crate) proxies: Proxies,
+    pub(crate) interactions: Interactions,
+    /// Avatars: input channel → point (stage 1 a).
+    pub(crate) avatars: Vec<Route>,
+    /// Audio-rate parameters: input channel → parameter slot (stage 1 b).
+    pub(crate) audio_params: Vec<Route>,
+    /// Force inputs: input channel → point (stage 4).
+    pub(crate) force_inputs: Vec<Route>,
+    /// `posOutput`: output channel ← point.
+    pub(crate) pos_outputs: Vec<Route>,
+    /// `frcOutput`: output channel ← point.
+    pub(crate) frc_outputs: Vec<Route>,
+
+    // Parameters.
+    pub(crate) program: Program,
+    pub(crate) stack: Vec<f64>,
+    /// Current parameter values, by parameter id.
+    pub(crate) params: Vec<f64>,
+    /// Arguments that depend on no audio-rate parameter: re-evaluated when a control
+    /// parameter or a class gain changes.
+    pub(crate) control_bindings: Vec<Binding>,
+    /// Arguments that depend on an audio-rate parameter: re-evaluated every sample.
+    pub(crate) audio_bindings: Vec<Binding>,
+    /// Single masses and proxies whose coefficients depend on audio-rate arguments.
+    pub(crate) audio_masses: Vec<u32>,
+    pub(crate) audio_proxies: Vec<u32>,
+    /// Scale factor of each [`ArgClass`] at this sample rate (spec §1.7).
+    pub(crate) class_scale: [f64; NUM_ARG_CLASSES],
+    /// Host gain of each class (1 unless the host changes it).
+    pub(crate) class_gain: [f64; NUM_ARG_CLASSES],
+    pub(crate) params_dirty: bool,
+
+    // Initial state.
+    pub(crate) init_runs: Vec<InitRun>,
+    /// Local indices of fixed nodes per macro, applied after `init_runs`: (first point, count
+    /// of points in the run, indices), flattened as point indices.
+    pub(crate) init_fixed_points: Vec<u32>,
+
+    // Guard and motion.
+    pub(crate) position_limit: f64,
+    pub(crate) guard: Option<GuardEvent>,
+    pub(crate) samples_since_reset: u64,
+    pub(crate) motion: Option<Arc<MotionStore>>,
+    pub(crate) motion_interval: u32,
+    pub(crate) motion_counter: u32,
+}
+
+/// An error setting a parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamError {
+    /// No control-rate parameter has that id.
+    UnknownParam(u32),
+    /// Audio-rate parameters take their value from an input.
+    AudioRate(u32),
+    /// The value is NaN or infinite.
+    NonFinite(f64),
+}
+
+impl std::fmt::Display for ParamError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ParamError::UnknownParam(id) => write!(f, "no parameter with id {id}"),
+            ParamError::AudioRate(id) => {
+                write!(f, "parameter {id} is audio-rate and follows its input")
+            }
+            ParamError::NonFinite(v) => write!(f, "parameter value {v} is not finite"),
+        }
+    }
+}
+
+impl std::error::Error for ParamError {}
+
+/// A parameter handle, stable for the life of one compiled model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ParamId(pub u32);
+
+/// What one [`Engine::process`] call did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BlockReport {
+    /// Frames simulated (not silenced by the guard).
+    pub simulated: usize,
+    /// True when the guard tripped during this block.
+    pub tripped: bool,
+}
+
+impl Engine {
+    /// The model's metadata: counts, labels, parameters, channels, motion layout.
+    pub fn info(&self) -> &ModelInfo {
+        &self.info
+    }
+
+    /// The sample rate the model was compiled for, in Hz.
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.info.sample_rate_hz
+    }
+
+    /// Looks up a parameter by name (off the audio thread: it compares strings).
+    pub fn param_id(&self, name: &str) -> Option<ParamId> {
+        self.info
+            .params
+            .iter()
+            .position(|p| p.name == name)
+            .map(|i| ParamId(i as u32))
+    }
+
+    /// The current value of a parameter (an audio-rate one holds its last input sample).
+    pub fn param(&self, id: ParamId) -> Option<f64> {
+        self.params.get(id.0 as usize).copied()
+    }
+
+    /// Sets a control-rate parameter. It takes effect at the start of the next
+    /// [`Engine::process`] call (spec §3.5). Realtime-safe.
+    pub fn set_param(&mut self, id: ParamId, value: f64) -> Result<(), ParamError> {
+        let info = self
+            .info
+            .params
+            .get(id.0 as usize)
+            .ok_or(ParamError::UnknownParam(id.0))?;
+        if info.audio_input.is_some() {
+            return Err(ParamError::AudioRate(id.0));
+        }
+        if !value.is_finite() {
+            return Err(ParamError::NonFinite(value));
+        }
+        if self.params[id.0 as usize] != value {
+            self.params[id.0 as usize] = value;
+            self.params_dirty = true;
+        }
+        Ok(())
+    }
+
+    /// Multiplies every argument of a scaling class by `gain` on top of the sample-rate factor:
+    /// the host's global Stiffness (K class) and Damping (Z class: Z, Znl, Zo) controls. Other
+    /// classes ignore it. Non-finite or negative gains are ignored. Takes effect at the next
+    /// block. Realtime-safe.
+    pub fn set_class_gain(&mut self, class: ScaleClass, gain: f64) {
+        let slot = match class {
+            ScaleClass::Stiffness => ArgClass::Stiffness,
+            ScaleClass::Damping => ArgClass::Damping,
+            ScaleClass::None | ScaleClass::Gravity => return,
+        } as usize;
+        if gain.is_finite() && gain >= 0.0 && self.class_gain[slot] != gain {
+            self.class_gain[slot] = gain;
+            self.params_dirty = true;
+        }
+    }
+
+    /// The host gain of a class (1 by default).
+    pub fn class_gain(&self, class: ScaleClass) -> f64 {
+        match class {
+            ScaleClass::Stiffness => self.class_gain[ArgClass::Stiffness as usize],
+            ScaleClass::Damping => self.class_gain[ArgClass::Damping as usize],
+            ScaleClass::None | ScaleClass::Gravity => 1.0,
+        }
+    }
+
+    /// The runaway limit on positions and outputs, in model units.
+    pub fn position_limit(&self) -> f64 {
+        self.position_limit
+    }
+
+    /// Sets the runaway limit (non-finite or non-positive values are ignored).
+    pub fn set_position_limit(&mut self, limit: f64) {
+        if limit.is_finite() && limit > 0.0 {
+            self.position_limit = limit;
+        }
+    }
+
+    /// The guard's event since the last reset. While it is set, the engine outputs silence.
+    pub fn guard_event(&self) -> Option<GuardEvent> {
+        self.guard
+    }
+
+    /// True while the guard holds the engine silent.
+    pub fn is_tripped(&self) -> bool {
+        self.guard.is_some()
+    }
+
+    /// Attaches (or detaches, with `None`) the motion store that stage 7 writes. While none is
+    /// attached, the refresh counter does not advance (spec §6.1). Realtime-safe, but dropping
+    /// the last `Arc` of a store frees it: detach off the audio thread.
+    pub fn set_motion_store(
+        &mut self,
+        store: Option<Arc<MotionStore>>,
+    ) -> Option<Arc<MotionStore>> {
+        self.motion_counter = 0;
+        std::mem::replace(&mut self.motion, store)
+    }
+
+    /// The motion refresh interval R, in samples.
+    pub fn motion_interval(&self) -> u32 {
+        self.motion_interval
+    }
+
+    /// Current positions of every point: the material points of [`ModelInfo::points`], then
+    /// the connection points.
+    pub fn positions(&self) -> &[f64] {
+        &self.points.x
+    }
+
+    /// Delayed positions x̃, in the order of [`Engine::positions`].
+    pub fn delayed_positions(&self) -> &[f64] {
+        &self.points.xp
+    }
+
+    /// Force accumulators, in the order of [`Engine::positions`].
+    pub fn forces(&self) -> &[f64] {
+        &self.points.f
+    }
+
+    /// Restores the initial state of spec §1.5 stage 0: positions from the current parameter
+    /// values, delayed positions from the initial velocities, every force cleared, the guard
+    /// and the motion counter reset. Parameters keep their values. Realtime-safe.
+    pub fn reset(&mut self) {
+        self.refresh_control();
+        self.points.f.fill(0.0);
+        for run in &self.init_runs {
+            let x0 = self.program.eval(run.x0, &self.params, &mut self.stack);
+            let xp = match run.rule {
+                InitRule::Fixed => x0,
+                InitRule::Velocity { v, factor } => {
+                    x0 - self.program.eval(v, &self.params, &mut self.stack) * factor
+                }
+                InitRule::Delayed { xr0, factor } => {
+                    x0 - (x0 - self.program.eval(xr0, &self.params, &mut self.stack)) * factor
+                }
+            };
+            let range = run.first as usize..(run.first + run.count) as usize;
+            self.points.x[range.clone()].fill(x0);
+            self.points.xp[range].fill(xp);
+        }
+        for &p in &self.init_fixed_points {
+            self.points.xp[p as usize] = self.points.x[p as usize];
+        }
+        // Connection points start at their interpolated position with no velocity.
+        for i in 0..self.proxies.len() {
+            let [n0, n1, n2, n3] = self.proxies.nodes[i];
+            let [w0, w1, w2, w3] = self.proxies.weights[i];
+            let x = &self.points.x;
+            let pos = w0 * x[n0 as usize]
+                + w1 * x[n1 as usize]
+                + w2 * x[n2 as usize]
+                + w3 * x[n3 as usize];
+            let k = self.proxies.base + i;
+            self.points.x[k] = pos;
+            self.points.xp[k] = pos;
+        }
+        self.guard = None;
+        self.samples_since_reset = 0;
+        self.motion_counter = 0;
+    }
+
+    /// Applies parameter and gain changes now instead of at the next block.
+    pub fn apply_pending_changes(&mut self) {
+        if self.params_dirty {
+            self.refresh_control();
+        }
+    }
+
+    /// Re-evaluates every argument that depends on no audio-rate parameter, then the derived
+    /// coefficients. Runs at a block boundary, only after a change.
+    fn refresh_control(&mut self) {
+        let scale = self.class_factors();
+        for b in &self.control_bindings {
+            self.args[b.slot as usize] =
+                self.program.eval(b.expr, &self.params, &mut self.stack) * scale[b.class as usize];
+        }
+        self.refresh_audio_args(&scale);
+        for i in 0..self.singles.len() {
+            self.singles.derive(i, &self.args);
+        }
+        for i in 0..self.proxies.len() {
+            self.proxies.derive(i, &self.args);
+        }
+        self.params_dirty = false;
+    }
+
+    #[inline]
+    fn class_factors(&self) -> [f64; NUM_ARG_CLASSES] {
+        let mut f = self.class_scale;
+        for (f, g) in f.iter_mut().zip(self.class_gain) {
+            *f *= g;
+        }
+        f
+    }
+
+    /// Evaluates the audio-rate arguments (stage 1 b consequences).
+    #[inline]
+    fn refresh_audio_args(&mut self, scale: &[f64; NUM_ARG_CLASSES]) {
+        for b in &self.audio_bindings {
+            self.args[b.slot as usize] =
+                self.program.eval(b.expr, &self.params, &mut self.stack) * scale[b.class as usize];
+        }
+    }
+
+    /// Runs `frames` samples. `inputs` holds the input channels one after the other, each
+    /// `frames` long (channel c at `inputs[c*frames..(c+1)*frames]`); channels it does not hold
+    /// are silent, and non-finite input samples count as 0. `outputs` receives the output
+    /// channels the same way; channels beyond its length are not written.
+    ///
+    /// Processing N frames in one call gives bit-identical results to N calls of one frame.
+    /// While the guard is tripped, the outputs are zero. Realtime-safe.
+    pub fn process(&mut self, frames: usize, inputs: &[f64], outputs: &mut [f64]) -> BlockReport {
+        let out_channels = if frames == 0 {
+            0
+        } else {
+            outputs.len() / frames
+        };
+        let in_channels = if frames == 0 {
+            0
+        } else {
+            inputs.len() / frames
+        };
+        outputs[..out_channels * frames].fill(0.0);
+        if self.params_dirty {
+            self.refresh_control();
+        }
+        let was_tripped = self.guard.is_some();
+        let mut simulated = 0;
+        if !was_tripped {
+            let scale = self.class_factors();
+            for n in 0..frames {
+                let input = |ch: u32| -> f64 {
+                    let ch = ch as usize;
+                    if ch < in_channels {
+                        let v = inputs[ch * frames + n];
+                        if v.is_finite() {
+                            v
+                        } else {
+                            0.0
+                        }
+                    } else {
+                        0.0
+                    }
+                };
+                self.step(&input, &scale);
+                simulated += 1;
+                if let Some(bad) = self.write_outputs(n, frames, out_channels, outputs) {
+                    self.trip(bad.0, None, Some(bad.1));
+                    for ch in 0..out_channels {
+                        outputs[ch * frames + n..(ch + 1) * frames].fill(0.0);
+                    }
+                    break;
+                }
+                self.samples_since_reset += 1;
+            }
+            if self.guard.is_none() {
+                self.scan_positions();
+            }
+        }
+        BlockReport {
+            simulated,
+            tripped: !was_tripped && self.guard.is_some(),
+        }
+    }
+
+    /// One sample: stages 1 to 5 and 7 of spec §1.5 (stage 6 is `write_outputs`).
+    #[inline]
+    fn step(&mut self, input: &impl Fn(u32) -> f64, scale: &[f64; NUM_ARG_CLASSES]) {
+        // Stage 1 a: avatars.
+        for r in &self.avatars {
+            let k = r.index as usize;
+            self.points.xp[k] = self.points.x[k];
+            self.points.x[k] = input(r.channel);
+            self.points.f[k] = 0.0;
+        }
+        // Stage 1 b: audio-rate parameters, and the arguments and coefficients that use them.
+        if !self.audio_params.is_empty() {
+            for r in &self.audio_params {
+                self.params[r.index as usize] = input(r.channel);
+            }
+            self.refresh_audio_args(scale);
+            for &i in &self.audio_masses {
+                self.singles.derive(i as usize, &self.args);
+            }
+            for &i in &self.audio_proxies {
+                self.proxies.derive(i as usize, &self.args);
+            }
+        }
+        // Stage 2 a: single mass-type elements; 2 b: macros and their internal links.
+        self.singles.step(&mut self.points);
+        self.macros.step(&mut self.points, &self.args);
+        // Stage 3: connection-point positions.
+        self.proxies.update_positions(&mut self.points);
+        // Stage 4: interactions, then force inputs.
+        self.interactions.step(&mut self.points, &self.args);
+        for r in &self.force_inputs {
+            self.points.f[r.index as usize] += input(r.channel);
+        }
+        // Stage 5: connection-point force spreading.
+        self.proxies.spread_forces(&mut self.points);
+        // Stage 7: motion buffers, on the first sample and then every R samples.
+        if let Some(store) = &self.motion {
+            if self.motion_counter == 0 {
+                store.write(&self.points.x[..self.info.num_points]);
+            }
+            self.motion_counter += 1;
+            if self.motion_counter >= self.motion_interval {
+                self.motion_counter = 0;
+            }
+        }
+    }
+
+    /// Stage 6: writes frame `n` of every output. Returns the first bad value's kind and
+    /// channel, if any.
+    #[inline]
+    fn write_outputs(
+        &self,
+        n: usize,
+        frames: usize,
+        out_channels: usize,
+        outputs: &mut [f64],
+    ) -> Option<(GuardKind, u32)> {
+        let limit = self.position_limit;
+        let mut bad = None;
+        let mut put = |r: &Route, v: f64| {
+            let ch = r.channel as usize;
+            if ch < out_channels {
+                outputs[ch * frames + n] = v;
+            }
+            if bad.is_none() {
+                if !v.is_finite() {
+                    bad = Some((GuardKind::NonFinite, r.channel));
+                } else if v.abs() > limit {
+                    bad = Some((GuardKind::Runaway, r.channel));
+                }
+            }
+        };
+        for r in &self.pos_outputs {
+            put(r, self.points.x[r.index as usize]);
+        }
+        for r in &self.frc_outputs {
+            put(r, self.points.f[r.index as usize]);
+        }
+        bad
+    }
+
+    /// Checks every position at the end of a block.
+    fn scan_positions(&mut self) {
+        let limit = self.position_limit;
+        let found = self.points.x.iter().position(|v| !(v.abs() <= limit));
+        if let Some(i) = found {
+            let kind = if self.points.x[i].is_finite() {
+                GuardKind::Runaway
+            } else {
+                GuardKind::NonFinite
+            };
+            self.trip(kind, Some(i as u32), None);
+        }
+    }
+
+    fn trip(&mut self, kind: GuardKind, point: Option<u32>, output: Option<u32>) {
+        self.guard = Some(GuardEvent {
+            sample: self.samples_since_reset,
+            kind,
+            point,
+            output,
+        });
+    }
+}

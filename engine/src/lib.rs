@@ -1,0 +1,42 @@
+//! # Ressort engine
+//!
+//! The mass-interaction physics core of Ressort: every element of the mi-gen~ toolbox with the
+//! equations of the reference specification (`shared/reference/mass-interaction.md`), a model
+//! spec with a Rust builder, a compiler to flat per-kind arrays, a realtime simulation, stability
+//! analysis and lock-free motion buffers. Plain Rust: no plugin or GUI dependency.
+//!
+//! ```
+//! use ressort_engine::{compile, CompileOptions, Endpoint, ModelBuilder};
+//! // A harmonic oscillator hit by a force impulse (Oscillator tutorial 0).
+//! let mut b = ModelBuilder::new();
+//! b.osc("o", 1.0, 0.1, 0.0003, 0.0, 0.0);
+//! b.frc_input(1, Endpoint::label("o"));
+//! b.pos_output(1, Endpoint::label("o"));
+//! let mut engine = compile(&b.build(), &CompileOptions::at(48_000.0)).unwrap();
+//! let mut input = vec![0.0; 64];
+//! input[0] = 1.0;
+//! let mut output = vec![0.0; 64];
+//! engine.process(64, &input, &mut output);
+//! assert!(output[1] != 0.0);
+//! ```
+
+pub mod compile;
+pub mod engine;
+pub mod expr;
+pub mod info;
+pub mod laws;
+pub mod motion;
+pub mod reference;
+pub mod spec;
+pub mod stability;
+
+pub use compile::{compile, CompileError, CompileErrorKind, CompileErrors, CompileOptions};
+pub use engine::{BlockReport, Engine, GuardEvent, GuardKind, ParamError, ParamId};
+pub use expr::{BinOp, Expr, Func};
+pub use info::{InputUse, ModelInfo, OutputUse, PointInfo, PointKind};
+pub use motion::{MotionLayout, MotionStore, NamedBuffer};
+pub use spec::{
+    Element, ElementKind, Endpoint, Law, MacroKind, MacroSpec, ModelBuilder, ModelSpec, ParamDecl,
+    ParamKind, SampleRateMode, ScaleClass, Span, Vector,
+};
+pub use stability::{MassStability, StabilityReport, StabilityWarning};
