@@ -229,6 +229,8 @@ struct Cx<'a> {
     proxies: Proxies,
     /// Connection points whose coordinates depend on an audio-rate parameter.
     proxy_audio: Vec<u32>,
+    /// The endpoint that created each connection point, to find points at the same location.
+    proxy_endpoints: Vec<&'a Endpoint>,
 }
 
 impl<'a> Cx<'a> {
@@ -432,6 +434,7 @@ impl<'a> Cx<'a> {
                 self.proxies.coord_slots.push([s0, s1]);
                 self.proxies.nodes.push([base; 4]);
                 self.proxies.weights.push([1.0, 0.0, 0.0, 0.0]);
+                self.proxy_endpoints.push(ep);
                 if audio0 || audio1 {
                     // Recomputed every sample.
                     self.proxy_audio.push(index as u32);
@@ -514,6 +517,7 @@ impl<'a> Compiler<'a> {
                 element_point: vec![None; spec.elements.len()],
                 proxies: Proxies::default(),
                 proxy_audio: Vec::new(),
+                proxy_endpoints: Vec::new(),
             },
         }
     }
@@ -886,6 +890,7 @@ impl<'a> Compiler<'a> {
         let mut force_inputs = Vec::new();
         let mut pos_outputs = Vec::new();
         let mut frc_outputs = Vec::new();
+        let mut frc_sources = Vec::new();
         let mut outputs: Vec<OutputUse> = Vec::new();
         for (i, e) in spec.elements.iter().enumerate() {
             let (channel, target, is_input, is_force) = match &e.kind {
@@ -914,7 +919,23 @@ impl<'a> Compiler<'a> {
                     outputs.resize(c, OutputUse::Unused);
                 }
                 if is_force {
-                    frc_outputs.push(route);
+                    // Each bracket creates its own connection point (spec §2.8), so a force
+                    // output on a bracket reads the force applied at that location: the sum
+                    // over every connection point with the same macro and coordinates, its own
+                    // included (spec §3.12 e).
+                    let start = frc_sources.len() as u32;
+                    match target {
+                        Endpoint::Label(_) => frc_sources.push(point),
+                        _ => frc_sources.extend(
+                            self.proxy_endpoints
+                                .iter()
+                                .enumerate()
+                                .filter(|(_, ep)| **ep == target)
+                                .map(|(i, _)| (proxy_base + i) as u32),
+                        ),
+                    }
+                    let len = frc_sources.len() as u32 - start;
+                    frc_outputs.push((route.channel, start, len));
                     outputs[c - 1] = OutputUse::Force(text);
                 } else {
                     pos_outputs.push(route);
@@ -1026,6 +1047,7 @@ impl<'a> Compiler<'a> {
             force_inputs,
             pos_outputs,
             frc_outputs,
+            frc_sources,
             program: cx.program,
             stack,
             params,

@@ -578,8 +578,11 @@ pub struct Engine {
     pub(crate) force_inputs: Vec<Route>,
     /// `posOutput`: output channel ← point.
     pub(crate) pos_outputs: Vec<Route>,
-    /// `frcOutput`: output channel ← point.
-    pub(crate) frc_outputs: Vec<Route>,
+    /// `frcOutput`: output channel ← the sum of F over `frc_sources[start..start+len]`, packed
+    /// as (channel, start, len). A plain target has one source; a connection point reads every
+    /// connection point at the same location (spec §3.12 e, see `compile`).
+    pub(crate) frc_outputs: Vec<(u32, u32, u32)>,
+    pub(crate) frc_sources: Vec<u32>,
 
     // Parameters.
     pub(crate) program: Program,
@@ -871,16 +874,8 @@ impl Engine {
     /// Processing N frames in one call gives bit-identical results to N calls of one frame.
     /// While the guard is tripped, the outputs are zero. Realtime-safe.
     pub fn process(&mut self, frames: usize, inputs: &[f64], outputs: &mut [f64]) -> BlockReport {
-        let out_channels = if frames == 0 {
-            0
-        } else {
-            outputs.len() / frames
-        };
-        let in_channels = if frames == 0 {
-            0
-        } else {
-            inputs.len() / frames
-        };
+        let out_channels = outputs.len().checked_div(frames).unwrap_or(0);
+        let in_channels = inputs.len().checked_div(frames).unwrap_or(0);
         outputs[..out_channels * frames].fill(0.0);
         if self.params_dirty {
             self.refresh_control();
@@ -999,8 +994,10 @@ impl Engine {
         for r in &self.pos_outputs {
             put(r, self.points.x[r.index as usize]);
         }
-        for r in &self.frc_outputs {
-            put(r, self.points.f[r.index as usize]);
+        for &(channel, start, len) in &self.frc_outputs {
+            let sources = &self.frc_sources[start as usize..(start + len) as usize];
+            let total = sources.iter().map(|&p| self.points.f[p as usize]).sum();
+            put(&Route { channel, index: 0 }, total);
         }
         bad
     }

@@ -163,8 +163,8 @@ mod tests {
 
     #[test]
     fn nl_contact_cubic_then_bounded_and_continuous() {
-        let (s, c, k) = (0.01, 0.1, 0.4);
-        let b = ((k - s) / c as f64).sqrt();
+        let (s, c, k): (f64, f64, f64) = (0.01, 0.1, 0.4);
+        let b = ((k - s) / c).sqrt();
         // Cubic region.
         let d = 0.5 * b;
         assert!(close(
@@ -194,8 +194,8 @@ mod tests {
 
     #[test]
     fn nl_spring_damper_extra_damping_only_when_bounded() {
-        let (s, c, k, z) = (0.03, 0.005, 0.8, 0.0002);
-        let b = ((k - s) / c as f64).sqrt();
+        let (s, c, k, z): (f64, f64, f64, f64) = (0.03, 0.005, 0.8, 0.0002);
+        let b = ((k - s) / c).sqrt();
         let dv = 0.001;
         let d = 0.5 * b;
         assert!(close(

@@ -13,7 +13,7 @@ use crate::expr::Expr;
 ///
 /// Spans are metadata: two specs that differ only in their spans compare equal, so
 /// `parse(print(parse(x))) == parse(x)` holds although printing moves text around.
-#[derive(Clone, Copy, Debug, Default, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, Eq)]
 pub struct Span {
     pub line: u32,
     pub col: u32,

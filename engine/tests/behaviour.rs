@@ -1,0 +1,481 @@
+//! Engine behaviour: block equivalence, reset, determinism, parameters, the guard, motion
+//! buffers, stability analysis and compile errors.
+
+mod common;
+
+use common::{engine, hash_f64s, impulse, render};
+use ressort_engine::{
+    compile, reference, CompileErrorKind, CompileOptions, Endpoint, Expr, Func, GuardKind, Law,
+    MacroKind, ModelBuilder, MotionStore, ScaleClass, StabilityWarning,
+};
+use std::sync::Arc;
+
+/// Deterministic excitation for a model: an impulse of −0.01 on in1 (spec §7.10), slow
+/// sinusoids on position inputs and mid-range constants on audio-rate parameters.
+fn excitation(e: &ressort_engine::Engine, frames: usize) -> Vec<Vec<f64>> {
+    use ressort_engine::InputUse;
+    e.info()
+        .inputs
+        .iter()
+        .enumerate()
+        .map(|(c, uses)| match uses.first() {
+            Some(InputUse::Force(_)) if c == 0 => impulse(-0.01, frames),
+            Some(InputUse::Force(_)) => vec![0.0; frames],
+            Some(InputUse::Position(_)) => (0..frames)
+                .map(|n| 0.05 * (n as f64 * 0.001 * (c + 1) as f64).sin())
+                .collect(),
+            Some(InputUse::Param(_)) => (0..frames)
+                .map(|n| 0.5 + 0.3 * (n as f64 * 0.0003 * (c + 1) as f64).sin())
+                .collect(),
+            None => vec![0.0; frames],
+        })
+        .collect()
+}
+
+#[test]
+fn one_block_equals_sample_by_sample_bit_for_bit() {
+    for (name, spec) in reference::all() {
+        let frames = if name == "chladni_150" { 300 } else { 3000 };
+        let mut a = engine(&spec, 48_000.0);
+        let input = excitation(&a, frames);
+        let whole = render(&mut a, frames, frames, &input);
+        for block in [1, 7, 333] {
+            let mut b = engine(&spec, 48_000.0);
+            let pieces = render(&mut b, frames, block, &input);
+            assert_eq!(
+                whole, pieces,
+                "{name}: block {block} differs from one block"
+            );
+            assert_eq!(a.positions(), b.positions(), "{name}: state differs");
+        }
+        assert!(
+            whole.iter().flatten().any(|v| *v != 0.0),
+            "{name}: excitation produced nothing"
+        );
+    }
+}
+
+#[test]
+fn reset_restores_the_initial_state_exactly() {
+    for (name, spec) in reference::all() {
+        let frames = if name == "chladni_150" { 200 } else { 2000 };
+        let mut e = engine(&spec, 44_100.0);
+        let x0 = e.positions().to_vec();
+        let xp0 = e.delayed_positions().to_vec();
+        let input = excitation(&e, frames);
+        let first = render(&mut e, frames, 64, &input);
+        e.reset();
+        assert_eq!(e.positions(), &x0[..], "{name}: positions after reset");
+        assert_eq!(
+            e.delayed_positions(),
+            &xp0[..],
+            "{name}: delayed after reset"
+        );
+        assert!(
+            e.forces().iter().all(|f| *f == 0.0),
+            "{name}: forces after reset"
+        );
+        let second = render(&mut e, frames, 64, &input);
+        assert_eq!(first, second, "{name}: render after reset differs");
+    }
+}
+
+/// FNV-1a of the first 4096 output samples of each reference model at 44.1 kHz. A change of
+/// these values is a change of the engine's numerics: check the physics tests, then update.
+const DETERMINISM: [(&str, u64); 7] = [
+    ("string_1000", 0x6622968c47594281),
+    ("string_1000_expanded", 0xed00c82939987fa3),
+    ("mesh_15x15", 0x97662210c8507609),
+    ("mesh_25x20", 0x7f5134ddbc354eaa),
+    ("fretted_string", 0x077a366bccced988),
+    ("chladni_150", 0xbeb06bcafbf591ea),
+    ("hammer_oscillator", 0xda297d49f435515e),
+];
+
+#[test]
+fn determinism_hash() {
+    let mut report = String::new();
+    let mut mismatch = false;
+    for (name, spec) in reference::all() {
+        let frames = if name == "chladni_150" { 512 } else { 4096 };
+        let mut e = engine(&spec, 44_100.0);
+        let input = excitation(&e, frames);
+        let out = render(&mut e, frames, 128, &input);
+        let h = hash_f64s(out.iter().flatten());
+        let expected = DETERMINISM.iter().find(|(n, _)| *n == name).map(|p| p.1);
+        report.push_str(&format!("    (\"{name}\", {h:#018x}),\n"));
+        mismatch |= expected != Some(h);
+    }
+    assert!(!mismatch, "determinism hashes changed:\n{report}");
+}
+
+#[test]
+fn control_parameters_change_without_recompiling() {
+    // Raising K of the hammer oscillator raises its pitch: more zero crossings.
+    let spec = {
+        let mut b = ModelBuilder::new();
+        b.param("K", 0.01);
+        b.osc("o", 1.0, "K", 0.0, 1.0, 0.0);
+        b.pos_output(1, Endpoint::label("o"));
+        b.build()
+    };
+    let crossings = |v: &[f64]| v.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
+    let mut e = engine(&spec, 44_100.0);
+    let low = render(&mut e, 4410, 441, &[]);
+    let id = e.param_id("K").unwrap();
+    e.set_param(id, 0.04).unwrap();
+    let high = render(&mut e, 4410, 441, &[]);
+    let ratio = crossings(&high[0]) as f64 / crossings(&low[0]) as f64;
+    assert!(
+        (ratio - 2.0).abs() < 0.1,
+        "K × 4 should double the pitch, ratio {ratio}"
+    );
+    assert!(e.set_param(id, f64::NAN).is_err());
+    assert_eq!(e.param(id), Some(0.04));
+}
+
+#[test]
+fn expressions_are_evaluated_with_current_parameters() {
+    // osc K = [stiffness + sqrt(kScale/3)] must equal a constant osc with the same value.
+    let mut b = ModelBuilder::new();
+    b.param("stiffness", 0.02).param("kScale", 0.0003);
+    let k = Expr::param("stiffness")
+        + Expr::call(Func::Sqrt, vec![Expr::param("kScale") / Expr::Num(3.0)]);
+    b.osc("o", 1.0, k, 0.0, 1.0, 0.0);
+    b.pos_output(1, Endpoint::label("o"));
+    let a = render(&mut engine(&b.build(), 48_000.0), 1000, 100, &[]);
+    let mut b = ModelBuilder::new();
+    b.osc("o", 1.0, 0.02 + (0.0003f64 / 3.0).sqrt(), 0.0, 1.0, 0.0);
+    b.pos_output(1, Endpoint::label("o"));
+    let c = render(&mut engine(&b.build(), 48_000.0), 1000, 100, &[]);
+    assert_eq!(a, c);
+}
+
+#[test]
+fn audio_rate_parameters_follow_their_input_every_sample() {
+    // Stability oscillator (tutorial 8): K is audio-rate on in2. Switching K from 0.01 to 0.04
+    // mid-block changes the recurrence at exactly that sample.
+    let spec = {
+        let mut b = ModelBuilder::new();
+        b.raw();
+        b.audio_param("K", 2);
+        b.osc("o", 1.0, "K", 0.0, 1.0, 0.0);
+        b.pos_output(1, Endpoint::label("o"));
+        b.build()
+    };
+    let frames = 100;
+    let k: Vec<f64> = (0..frames)
+        .map(|n| if n < 50 { 0.01 } else { 0.04 })
+        .collect();
+    let out = render(
+        &mut engine(&spec, 44_100.0),
+        frames,
+        frames,
+        &[vec![0.0; frames], k],
+    );
+    // Reproduce by hand: X = (2 − K)X − X̃.
+    let (mut x, mut xp) = (1.0f64, 1.0f64);
+    for n in 0..frames {
+        let kk = if n < 50 { 0.01 } else { 0.04 };
+        let next = (2.0 - kk) * x + (0.0 - 1.0) * xp;
+        xp = x;
+        x = next;
+        assert!(
+            (out[0][n] - x).abs() < 1e-13,
+            "sample {n}: {} vs {x}",
+            out[0][n]
+        );
+    }
+}
+
+#[test]
+fn class_gain_scales_every_stiffness() {
+    // A stiffness gain of 4 on a string doubles its pitch (K ∝ f² for low modes).
+    let spec = reference::mesh_15x15();
+    let mut a = engine(&spec, 44_100.0);
+    let mut b = engine(&spec, 44_100.0);
+    b.set_class_gain(ScaleClass::Stiffness, 4.0);
+    let mut c = engine(&spec, 44_100.0);
+    c.set_class_gain(ScaleClass::Stiffness, 1.0);
+    let input = excitation(&a, 2000);
+    let ra = render(&mut a, 2000, 100, &input);
+    let rb = render(&mut b, 2000, 100, &input);
+    let rc = render(&mut c, 2000, 100, &input);
+    assert_eq!(ra, rc, "a gain of 1 changes nothing");
+    assert_ne!(ra, rb);
+    assert_eq!(b.class_gain(ScaleClass::Stiffness), 4.0);
+}
+
+#[test]
+fn guard_silences_an_exploding_model_until_reset() {
+    // K/M = 5 > 4: numerically unstable (spec §5.1).
+    let spec = {
+        let mut b = ModelBuilder::new();
+        b.raw();
+        b.osc("o", 1.0, 5.0, 0.0, 0.001, 0.0);
+        b.pos_output(1, Endpoint::label("o"));
+        b.build()
+    };
+    let mut e = engine(&spec, 44_100.0);
+    let out = render(&mut e, 20_000, 512, &[]);
+    assert!(out[0]
+        .iter()
+        .all(|v| v.is_finite() && v.abs() <= e.position_limit()));
+    let ev = e.guard_event().expect("the guard must trip");
+    assert_eq!(ev.kind, GuardKind::Runaway);
+    assert!(out[0][ev.sample as usize..].iter().all(|v| *v == 0.0));
+    // Still silent on later blocks.
+    let later = render(&mut e, 1000, 100, &[]);
+    assert!(later[0].iter().all(|v| *v == 0.0));
+    e.reset();
+    assert!(!e.is_tripped());
+    let again = render(&mut e, 10, 10, &[]);
+    assert_ne!(again[0][1], 0.0);
+    // The stability analysis predicted it.
+    let report = e.stability();
+    assert!(!report.is_stable());
+    assert_eq!(report.violations().next().unwrap().label, "o");
+}
+
+#[test]
+fn non_finite_inputs_count_as_silence() {
+    let spec = reference::hammer_oscillator();
+    let mut e = engine(&spec, 44_100.0);
+    let bad = vec![f64::NAN, f64::INFINITY, f64::NEG_INFINITY, f64::NAN];
+    let out = render(&mut e, 4, 4, &[bad]);
+    assert!(out.iter().flatten().all(|v| v.is_finite()));
+    assert!(!e.is_tripped());
+}
+
+#[test]
+fn odd_block_shapes_are_harmless() {
+    let spec = reference::hammer_oscillator();
+    let mut e = engine(&spec, 44_100.0);
+    // Zero frames, missing input channels, too few output channels.
+    assert_eq!(e.process(0, &[], &mut []).simulated, 0);
+    let mut one = vec![0.0; 16];
+    assert_eq!(e.process(16, &[], &mut one).simulated, 16);
+    let mut ragged = vec![0.0; 17];
+    e.process(16, &[0.0; 5], &mut ragged);
+}
+
+#[test]
+fn motion_buffers_are_written_on_the_first_sample_and_every_interval() {
+    let mut b = ModelBuilder::new();
+    b.raw();
+    b.begin_scope("pair");
+    b.mass("a", 1.0, 0.5, 0.01);
+    b.begin_scope("both");
+    b.mass("b", 1.0, -0.5, 0.0);
+    b.end_scope("pair");
+    b.macro_1d("s", MacroKind::String, 4, 1.0, 0.1, 0.0);
+    b.end_scope("both");
+    b.pos_input(1, 0.25);
+    let spec = b.build();
+    let mut e = compile(
+        &spec,
+        &CompileOptions {
+            sample_rate_hz: 44_100.0,
+            motion_interval: 10,
+        },
+    )
+    .unwrap();
+    let store = Arc::new(MotionStore::new(e.info().num_points));
+    e.set_motion_store(Some(Arc::clone(&store)));
+    let mut z = vec![0.0; store.len()];
+    assert_eq!(store.read(&mut z), None);
+    e.process(1, &[0.3], &mut []);
+    assert_eq!(store.frames_written(), 1);
+    store.read(&mut z).unwrap();
+    // Generic order: single masses, macro nodes, avatars (spec §6.2).
+    assert_eq!(z.len(), 2 + 4 + 1);
+    assert_eq!(z[0], e.positions()[0]);
+    assert_eq!(z[6], 0.3, "the avatar follows its input");
+    e.process(25, &[0.3; 25], &mut []);
+    assert_eq!(store.frames_written(), 3, "frames at samples 0, 10 and 20");
+    // Named buffers: nested and overlapping scopes (spec §3.10).
+    let layout = &e.info().motion;
+    assert_eq!(layout.named("pair").unwrap().members, vec![0, 1]);
+    assert_eq!(layout.named("both").unwrap().members, vec![1, 2, 3, 4, 5]);
+    let mut named = vec![0.0; 2];
+    store
+        .read_named(layout.named("pair").unwrap(), &mut z, &mut named)
+        .unwrap();
+    assert_eq!(named, vec![z[0], z[1]]);
+    // Detached: no more frames.
+    e.set_motion_store(None);
+    e.process(50, &[0.3; 50], &mut []);
+    assert_eq!(store.frames_written(), 3);
+}
+
+#[test]
+fn stability_report_names_masses_and_structures() {
+    // A string with K/M = 0.1 passes everything.
+    let mut e = engine(&reference::string_1000(), 44_100.0);
+    let r = e.stability();
+    assert!(r.is_stable());
+    assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+    let worst = r.worst().unwrap();
+    // An interior string node: K_eq = 2K, Z_eq = 2Z, margin 4 − (0.2 + 0.004).
+    assert!(worst.label.starts_with("s["), "{}", worst.label);
+    assert!(worst.k_eq >= 0.2 && worst.margin() < 3.8);
+
+    // A mesh with K/M = 0.6 passes the per-mass rule (4K = 2.4 < 4) but not the stricter
+    // mesh limit 2K + 4Z + Zo/2 < M.
+    let mut b = ModelBuilder::new();
+    b.mesh("me", MacroKind::CornerMesh, 8, 8, 1.0, 0.6, 0.001);
+    let r = engine(&b.build(), 44_100.0).stability();
+    assert!(r.is_stable());
+    assert!(r
+        .warnings
+        .iter()
+        .any(|w| matches!(w, StabilityWarning::StructureLimit { label, .. } if label == "me")));
+
+    // Unbounded nonlinear springs are flagged; bounded ones count at 3k − 2s.
+    let mut b = ModelBuilder::new();
+    b.raw();
+    b.mass("m", 1.0, 0.0, 0.0).ground("g", 0.0);
+    b.interaction(
+        "n3",
+        Law::NlSpring3 {
+            k: 0.1.into(),
+            q: 2.0.into(),
+            z: 0.0.into(),
+        },
+        Endpoint::label("g"),
+        Endpoint::label("m"),
+    );
+    b.interaction(
+        "nb",
+        Law::NlSpringDamper {
+            k: 0.03.into(),
+            q: 0.005.into(),
+            klim: 0.8.into(),
+            z: 0.0002.into(),
+        },
+        Endpoint::label("g"),
+        Endpoint::label("m"),
+    );
+    let r = engine(&b.build(), 44_100.0).stability();
+    assert!(r.warnings.iter().any(|w| matches!(
+        w,
+        StabilityWarning::Unbounded {
+            keyword: "nlSpring3",
+            ..
+        }
+    )));
+    let m = &r.masses[0];
+    assert!(
+        (m.k_eq - (0.1 + 3.0 * 0.8 - 2.0 * 0.03)).abs() < 1e-12,
+        "{}",
+        m.k_eq
+    );
+    assert!((m.z_eq - (0.0002 + 0.3 * 0.8)).abs() < 1e-12, "{}", m.z_eq);
+
+    // Scaling: at 22.05 kHz the per-step K quadruples and the string interior load grows.
+    let mut lo = engine(&reference::string_1000(), 22_050.0);
+    let l = lo.stability().worst().unwrap().k_eq;
+    assert!((l / worst.k_eq - 4.0).abs() < 0.05);
+}
+
+#[test]
+fn compile_errors_are_collected_with_labels() {
+    let mut b = ModelBuilder::new();
+    b.param("K", 0.1);
+    b.macro_1d("s", MacroKind::String, 10, 1.0, "K", "Zz"); // undefined name
+    b.mass("s", 1.0, 0.0, 0.0); // duplicate label
+    b.spring_damper(
+        "l1",
+        Endpoint::label("s"),
+        Endpoint::label("nowhere"),
+        0.1,
+        0.0,
+    );
+    b.spring_damper(
+        "l2",
+        Endpoint::at2("s", 0.1, 0.2),
+        Endpoint::at("K", 0.5),
+        0.1,
+        0.0,
+    );
+    b.mass("bad", 0.0, 0.0, 0.0); // M must be > 0
+    b.pos_output(1, Endpoint::label("l1")); // not a point
+    let errors = compile(&b.build(), &CompileOptions::default())
+        .unwrap_err()
+        .0;
+    let kinds: Vec<&CompileErrorKind> = errors.iter().map(|e| &e.kind).collect();
+    let has = |f: &dyn Fn(&CompileErrorKind) -> bool| kinds.iter().any(|k| f(k));
+    assert!(has(
+        &|k| matches!(k, CompileErrorKind::UndefinedName(n) if n == "Zz")
+    ));
+    assert!(has(&|k| matches!(
+        k,
+        CompileErrorKind::DuplicateLabel { .. }
+    )));
+    assert!(has(
+        &|k| matches!(k, CompileErrorKind::UndefinedElement(t) if t == "nowhere")
+    ));
+    assert!(has(&|k| matches!(
+        k,
+        CompileErrorKind::WrongCoordinateCount {
+            expected: 1,
+            found: 2,
+            ..
+        }
+    )));
+    assert!(has(
+        &|k| matches!(k, CompileErrorKind::NotAMacro(t) if t == "K")
+    ));
+    assert!(has(&|k| matches!(k, CompileErrorKind::InvalidValue { .. })));
+    assert!(has(&|k| matches!(
+        k,
+        CompileErrorKind::NotAPoint {
+            found: "an interaction",
+            ..
+        }
+    )));
+    let text = errors
+        .iter()
+        .map(|e| e.to_string())
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(text.contains("@s: undefined name `Zz`"), "{text}");
+
+    // Bad sample rates and absurd sizes.
+    let spec = reference::hammer_oscillator();
+    for sr in [0.0, -44_100.0, f64::NAN, f64::INFINITY, 1e12] {
+        let e = compile(&spec, &CompileOptions::at(sr)).unwrap_err();
+        assert!(matches!(
+            e.0[0].kind,
+            CompileErrorKind::InvalidSampleRate(_)
+        ));
+    }
+    let mut b = ModelBuilder::new();
+    b.mesh("huge", MacroKind::Mesh, 100_000, 100_000, 1.0, 0.1, 0.0);
+    let e = compile(&b.build(), &CompileOptions::default()).unwrap_err();
+    assert!(matches!(e.0[0].kind, CompileErrorKind::TooLarge { .. }));
+}
+
+#[test]
+fn reference_models_have_the_published_counts() {
+    // Points / interactions of spec §7.
+    let expected = [
+        ("string_1000", 1004, 1003),
+        ("string_1000_expanded", 1004, 1003),
+        ("mesh_15x15", 227, 422),
+        ("mesh_25x20", 502, 957),
+        ("fretted_string", 169, 203),
+        ("chladni_150", 22_503, 44_703),
+        ("hammer_oscillator", 3, 2),
+    ];
+    for (name, spec) in reference::all() {
+        let e = engine(&spec, 44_100.0);
+        let (_, points, interactions) = expected.iter().find(|x| x.0 == name).unwrap();
+        assert_eq!(e.info().num_points, *points, "{name} points");
+        assert_eq!(
+            e.info().num_interactions,
+            *interactions,
+            "{name} interactions"
+        );
+    }
+}

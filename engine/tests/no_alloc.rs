@@ -1,0 +1,109 @@
+//! Proves that nothing allocates after compile: a counting global allocator wraps the system
+//! one, and every reference model runs through process, parameter and gain changes, reset and
+//! motion writes while counting. Runs without the test harness so no other thread allocates.
+
+use ressort_engine::{compile, reference, CompileOptions, MotionStore, ScaleClass};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
+
+struct Counting;
+
+static COUNTING: AtomicBool = AtomicBool::new(false);
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if COUNTING.load(Ordering::Relaxed) {
+            ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        }
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        if COUNTING.load(Ordering::Relaxed) {
+            ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        }
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if COUNTING.load(Ordering::Relaxed) {
+            ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        }
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn counted<R>(f: impl FnOnce() -> R) -> (R, usize) {
+    ALLOCATIONS.store(0, Ordering::SeqCst);
+    COUNTING.store(true, Ordering::SeqCst);
+    let r = f();
+    COUNTING.store(false, Ordering::SeqCst);
+    (r, ALLOCATIONS.load(Ordering::SeqCst))
+}
+
+fn main() {
+    // The counter itself must see allocations, or the test proves nothing.
+    let (_, n) = counted(|| std::hint::black_box(vec![1u8; 64]));
+    assert!(n >= 1, "the counting allocator does not count");
+
+    let mut passed = 0;
+    let mut failed = 0;
+    for (name, spec) in reference::all() {
+        let mut e = compile(&spec, &CompileOptions::at(48_000.0)).unwrap();
+        let frames = 256;
+        let in_ch = e.info().num_inputs();
+        let out_ch = e.info().num_outputs();
+        let mut input = vec![0.0; in_ch * frames];
+        if in_ch > 0 {
+            input[0] = -0.01;
+        }
+        for (c, chunk) in input.chunks_mut(frames).enumerate().skip(1) {
+            chunk.iter_mut().for_each(|v| *v = 0.3 + 0.01 * c as f64);
+        }
+        let mut output = vec![0.0; out_ch * frames];
+        let store = Arc::new(MotionStore::new(e.info().num_points));
+        let store_for_engine = Arc::clone(&store);
+        let param = (0..e.info().params.len())
+            .map(|i| ressort_engine::ParamId(i as u32))
+            .find(|&id| e.info().params[id.0 as usize].audio_input.is_none());
+        let blocks = if name == "chladni_150" { 2 } else { 20 };
+        let (_, allocations) = counted(|| {
+            e.set_motion_store(Some(store_for_engine));
+            for b in 0..blocks {
+                e.process(frames, &input, &mut output);
+                if let Some(id) = param {
+                    let v = e.param(id).unwrap_or(0.0);
+                    let _ = e.set_param(id, v * (1.0 + 1e-3 * b as f64));
+                }
+                e.set_class_gain(ScaleClass::Stiffness, 1.0 + 0.01 * b as f64);
+                e.set_class_gain(ScaleClass::Damping, 1.0 - 0.01 * b as f64);
+                // Odd block sizes.
+                e.process(1, &input[..in_ch], &mut output[..out_ch]);
+            }
+            e.reset();
+            e.process(frames, &input, &mut output);
+        });
+        let frames_written = store.frames_written();
+        if allocations == 0 && frames_written > 0 {
+            passed += 1;
+            println!("test no_alloc::{name} ... ok");
+        } else {
+            failed += 1;
+            println!(
+                "test no_alloc::{name} ... FAILED ({allocations} allocations, {frames_written} \
+                 motion frames)"
+            );
+        }
+    }
+    println!();
+    println!("{passed} passed, {failed} failed");
+    if failed > 0 {
+        std::process::exit(1);
+    }
+}
