@@ -23,6 +23,7 @@
 pub mod compile;
 pub mod engine;
 pub mod expr;
+pub mod generators;
 pub mod info;
 pub mod laws;
 pub mod motion;
