@@ -611,15 +611,12 @@ fn emit(
         out.nodes.push(label);
         out.fixed.push(node.fixed);
     }
-    let mut r = 0;
-    for (&(a, bb), ks) in links
+    let all = links
         .iter()
         .map(|l| (l, false))
-        .chain(stiff.iter().map(|l| (l, true)))
-        .map(|(l, s)| (l, s))
-    {
+        .chain(stiff.iter().map(|l| (l, true)));
+    for (r, (&(a, bb), ks)) in all.enumerate() {
         let label = p(&format!("r{r}"));
-        r += 1;
         let (k, z) = if ks {
             (Expr::param(&p("Ks")), Expr::Num(0.0))
         } else {

@@ -25,6 +25,7 @@ pub mod engine;
 pub mod expr;
 pub mod generators;
 pub mod info;
+pub mod lang;
 pub mod laws;
 pub mod motion;
 pub mod reference;
@@ -35,6 +36,7 @@ pub use compile::{compile, CompileError, CompileErrorKind, CompileErrors, Compil
 pub use engine::{BlockReport, Engine, GuardEvent, GuardKind, ParamError, ParamId};
 pub use expr::{BinOp, Expr, Func};
 pub use info::{InputUse, ModelInfo, OutputUse, PointInfo, PointKind};
+pub use lang::{parse, parse_bytes, print, Diagnostic, DiagnosticCode, Parsed, Severity};
 pub use motion::{MotionLayout, MotionStore, NamedBuffer};
 pub use spec::{
     Element, ElementKind, Endpoint, Law, MacroKind, MacroSpec, ModelBuilder, ModelSpec, ParamDecl,

@@ -226,9 +226,11 @@ fn hexagon_counts() {
 fn lattice_counts() {
     // Without diagonals and span 1: (Nx−1)NyNz + Nx(Ny−1)Nz + NxNy(Nz−1).
     let size = [2usize, 3, 4];
-    let axis = (1 * 3 * 4) + (2 * 2 * 4) + (2 * 3 * 3);
+    // (Nx−1)·Ny·Nz + Nx·(Ny−1)·Nz + Nx·Ny·(Nz−1) with (2, 3, 4).
+    let axis = 3 * 4 + 2 * 2 * 4 + 2 * 3 * 3;
     let corners = 8;
-    let borders = 24 - 0; // (Nx−2)+ = 0: every node is on the boundary.
+    // N − (Nx−2)+(Ny−2)+(Nz−2)+ = 24 − 0: with Nx = 2 every node is on the boundary.
+    let borders = 24;
     check(
         Topology::Lattice {
             size,

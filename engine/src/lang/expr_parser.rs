@@ -1,0 +1,659 @@
+//! Argument expressions and number literals (spec §3.5, normative decision §3.12 c).
+//!
+//! ```text
+//! expr    := term  { ("+" | "-") term }
+//! term    := unary { ("*" | "/") unary }
+//! unary   := ("-" | "+") unary | primary
+//! primary := number | name | call | "(" expr ")"
+//! call    := func "(" expr { "," expr } ")"
+//! number  := digits [ "." [digits] ] [ exponent ] | "." digits [ exponent ]
+//! exponent:= ("e" | "E") [ "+" | "-" ] digits
+//! ```
+//!
+//! A unary minus written directly before a number literal folds into the literal (`-0.2` is
+//! `Expr::Num(-0.2)`, as the builder writes it); before anything else, including a parenthesised
+//! number, it is [`Expr::Neg`]. Unary plus is dropped. Recursion and tree depth are capped at
+//! [`MAX_NESTING`] so no input can overflow the stack.
+
+use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
+use super::lexer::is_blank;
+use crate::expr::{BinOp, Expr, Func};
+use std::collections::HashMap;
+
+/// The deepest nesting (parentheses, calls, unary operators) and the deepest expression tree the
+/// front end accepts. Below the compiler's own limit of 256 (`compile::MAX_EXPR_DEPTH`).
+pub const MAX_NESTING: usize = 200;
+
+/// What a label names, for name resolution and endpoint checks (spec §3.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SymKind {
+    /// `param` or `audioParam`.
+    Param,
+    /// A mass-type element or an avatar: a valid endpoint.
+    Point,
+    /// A macro addressed with `dims` connection coordinates.
+    Macro {
+        dims: usize,
+    },
+    Interaction,
+    FrcInput,
+    Output,
+    /// A line whose keyword is unknown: references to it are not checked (no cascades).
+    Unknown,
+}
+
+impl SymKind {
+    pub(crate) fn describe(self) -> &'static str {
+        match self {
+            SymKind::Param => "a parameter",
+            SymKind::Point => "a point",
+            SymKind::Macro { .. } => "a macro",
+            SymKind::Interaction => "an interaction",
+            SymKind::FrcInput => "a force input",
+            SymKind::Output => "an output",
+            SymKind::Unknown => "an element of unknown type",
+        }
+    }
+}
+
+/// A declared label: what it names and where it was declared.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Symbol {
+    pub kind: SymKind,
+    pub line: u32,
+    pub col: u32,
+}
+
+pub(crate) type Symbols = HashMap<String, Symbol>;
+
+/// True for identifiers `[A-Za-z_][A-Za-z0-9_]*` (spec §3.4).
+pub(crate) fn is_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+fn col_at(base: u32, i: usize) -> u32 {
+    base.saturating_add(u32::try_from(i).unwrap_or(u32::MAX))
+}
+
+/// Scans the number grammar of spec §3.5 from `start`. Returns the end index, or `None` when no
+/// number starts there.
+fn scan_number(chars: &[char], start: usize) -> Option<usize> {
+    let digits = |mut j: usize| {
+        while chars.get(j).is_some_and(char::is_ascii_digit) {
+            j += 1;
+        }
+        j
+    };
+    let mut j = digits(start);
+    let int_digits = j - start;
+    let mut frac_digits = 0;
+    if chars.get(j) == Some(&'.') {
+        let k = digits(j + 1);
+        frac_digits = k - (j + 1);
+        j = k;
+    }
+    if int_digits == 0 && frac_digits == 0 {
+        return None;
+    }
+    if matches!(chars.get(j), Some('e' | 'E')) {
+        let mut k = j + 1;
+        if matches!(chars.get(k), Some('+' | '-')) {
+            k += 1;
+        }
+        if chars.get(k).is_some_and(char::is_ascii_digit) {
+            j = digits(k);
+        }
+    }
+    Some(j)
+}
+
+/// Why a literal was rejected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum NumberError {
+    Invalid,
+    NonFinite,
+}
+
+fn to_f64(chars: &[char]) -> Result<f64, NumberError> {
+    let s: String = chars.iter().collect();
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(NumberError::NonFinite),
+        Err(_) => Err(NumberError::Invalid),
+    }
+}
+
+/// A numeric literal with an optional sign, the only form allowed for `param` values and legacy
+/// tag coordinates (spec §3.5, §3.8, §6.4).
+pub(crate) fn parse_number_literal(chars: &[char]) -> Result<f64, NumberError> {
+    let (negative, body) = match chars.split_first() {
+        Some(('-', rest)) => (true, rest),
+        Some(('+', rest)) => (false, rest),
+        _ => (false, chars),
+    };
+    match scan_number(body, 0) {
+        Some(end) if end == body.len() => to_f64(body).map(|v| if negative { -v } else { v }),
+        _ => Err(NumberError::Invalid),
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Tok {
+    Num(f64),
+    Ident(String),
+    Op(char),
+    End,
+}
+
+/// Where a name is being resolved from, for messages.
+pub(crate) struct ExprContext<'a> {
+    pub symbols: &'a Symbols,
+    pub line: u32,
+    pub label: Option<&'a str>,
+}
+
+struct ExprParser<'a, 'd> {
+    toks: Vec<(Tok, u32)>,
+    pos: usize,
+    nest: usize,
+    cx: &'a ExprContext<'a>,
+    diags: &'d mut Diags,
+    /// A non-fatal error was reported (undefined name, wrong arity): the result is discarded.
+    failed: bool,
+}
+
+/// Parses `chars` (whose first character stands at column `col`) as an expression. Reports every
+/// problem and returns `None` when there was any.
+pub(crate) fn parse_expression(
+    chars: &[char],
+    col: u32,
+    cx: &ExprContext<'_>,
+    diags: &mut Diags,
+) -> Option<Expr> {
+    let toks = lex(chars, col, cx, diags)?;
+    let mut p = ExprParser {
+        toks,
+        pos: 0,
+        nest: 0,
+        cx,
+        diags,
+        failed: false,
+    };
+    let (e, _) = p.expr()?;
+    if p.peek() != &Tok::End {
+        let found = p.describe_current();
+        p.syntax_error(format!("unexpected {found} after the expression"));
+        return None;
+    }
+    if p.failed {
+        None
+    } else {
+        Some(e)
+    }
+}
+
+fn lex(
+    chars: &[char],
+    col: u32,
+    cx: &ExprContext<'_>,
+    diags: &mut Diags,
+) -> Option<Vec<(Tok, u32)>> {
+    let mut toks = Vec::new();
+    let mut i = 0;
+    while let Some(&c) = chars.get(i) {
+        if is_blank(c) {
+            i += 1;
+            continue;
+        }
+        let at = col_at(col, i);
+        if c.is_ascii_digit() || (c == '.' && chars.get(i + 1).is_some_and(char::is_ascii_digit)) {
+            let end = scan_number(chars, i).unwrap_or(i + 1);
+            // A number glued to letters, digits or a dot (`40abc`, `1.2.3`, `1e`) is invalid.
+            let mut bad_end = end;
+            while chars
+                .get(bad_end)
+                .is_some_and(|c| c.is_alphanumeric() || *c == '_' || *c == '.')
+            {
+                bad_end += 1;
+            }
+            let text = chars.get(i..bad_end).unwrap_or(&[]);
+            if bad_end > end {
+                diags.push(
+                    Diagnostic::new(
+                        DiagnosticCode::InvalidNumber,
+                        cx.line,
+                        at,
+                        format!("invalid number `{}`", text.iter().collect::<String>()),
+                    )
+                    .with_label(cx.label)
+                    .with_found(text.iter().collect::<String>()),
+                );
+                return None;
+            }
+            match to_f64(text) {
+                Ok(v) => toks.push((Tok::Num(v), at)),
+                Err(e) => {
+                    let s: String = text.iter().collect();
+                    let (code, msg) = match e {
+                        NumberError::NonFinite => (
+                            DiagnosticCode::NonFiniteNumber,
+                            format!("non-finite number `{s}`"),
+                        ),
+                        NumberError::Invalid => (
+                            DiagnosticCode::InvalidNumber,
+                            format!("invalid number `{s}`"),
+                        ),
+                    };
+                    diags.push(
+                        Diagnostic::new(code, cx.line, at, msg)
+                            .with_label(cx.label)
+                            .with_found(s),
+                    );
+                    return None;
+                }
+            }
+            i = end;
+        } else if c.is_ascii_alphabetic() || c == '_' {
+            let start = i;
+            while chars
+                .get(i)
+                .is_some_and(|c| c.is_ascii_alphanumeric() || *c == '_')
+            {
+                i += 1;
+            }
+            let name: String = chars.get(start..i).unwrap_or(&[]).iter().collect();
+            toks.push((Tok::Ident(name), at));
+        } else if matches!(c, '+' | '-' | '*' | '/' | '(' | ')' | ',') {
+            toks.push((Tok::Op(c), at));
+            i += 1;
+        } else {
+            let hint = match c {
+                '@' => {
+                    " (parameters are referred to without `@`; connection points only go in \
+                        endpoint slots)"
+                }
+                '^' => " (use pow(x, y))",
+                _ => "",
+            };
+            diags.push(
+                Diagnostic::new(
+                    DiagnosticCode::ExpressionSyntax,
+                    cx.line,
+                    at,
+                    format!("unexpected character `{c}` in expression{hint}"),
+                )
+                .with_label(cx.label)
+                .with_found(c.to_string()),
+            );
+            return None;
+        }
+    }
+    toks.push((Tok::End, col_at(col, chars.len())));
+    Some(toks)
+}
+
+impl ExprParser<'_, '_> {
+    fn peek(&self) -> &Tok {
+        self.toks.get(self.pos).map(|t| &t.0).unwrap_or(&Tok::End)
+    }
+
+    fn col(&self) -> u32 {
+        self.toks
+            .get(self.pos)
+            .or(self.toks.last())
+            .map(|t| t.1)
+            .unwrap_or(1)
+    }
+
+    fn bump(&mut self) {
+        if self.pos < self.toks.len() {
+            self.pos += 1;
+        }
+    }
+
+    fn describe_current(&self) -> String {
+        match self.peek() {
+            Tok::Num(v) => format!("number `{v}`"),
+            Tok::Ident(n) => format!("name `{n}`"),
+            Tok::Op(c) => format!("`{c}`"),
+            Tok::End => "end of expression".to_string(),
+        }
+    }
+
+    fn error_at(&mut self, code: DiagnosticCode, col: u32, message: String) {
+        self.diags
+            .push(Diagnostic::new(code, self.cx.line, col, message).with_label(self.cx.label));
+    }
+
+    fn syntax_error(&mut self, message: String) {
+        let col = self.col();
+        self.error_at(DiagnosticCode::ExpressionSyntax, col, message);
+    }
+
+    /// Enters one nesting level; `false` (with an error) beyond [`MAX_NESTING`].
+    fn enter(&mut self) -> bool {
+        self.nest += 1;
+        if self.nest > MAX_NESTING {
+            let col = self.col();
+            self.error_at(
+                DiagnosticCode::ExpressionTooDeep,
+                col,
+                format!("expression nested deeper than {MAX_NESTING} levels"),
+            );
+            return false;
+        }
+        true
+    }
+
+    /// Combines subtree depths, rejecting trees deeper than [`MAX_NESTING`].
+    fn depth(&mut self, d: usize, col: u32) -> Option<usize> {
+        if d > MAX_NESTING {
+            self.error_at(
+                DiagnosticCode::ExpressionTooDeep,
+                col,
+                format!("expression nested deeper than {MAX_NESTING} levels"),
+            );
+            return None;
+        }
+        Some(d)
+    }
+
+    fn expr(&mut self) -> Option<(Expr, usize)> {
+        if !self.enter() {
+            return None;
+        }
+        let r = self.expr_inner();
+        self.nest -= 1;
+        r
+    }
+
+    fn expr_inner(&mut self) -> Option<(Expr, usize)> {
+        let (mut e, mut d) = self.term()?;
+        loop {
+            let op = match self.peek() {
+                Tok::Op('+') => BinOp::Add,
+                Tok::Op('-') => BinOp::Sub,
+                _ => return Some((e, d)),
+            };
+            let col = self.col();
+            self.bump();
+            let (rhs, rd) = self.term()?;
+            d = self.depth(1 + d.max(rd), col)?;
+            e = Expr::Binary(op, Box::new(e), Box::new(rhs));
+        }
+    }
+
+    fn term(&mut self) -> Option<(Expr, usize)> {
+        let (mut e, mut d) = self.unary()?;
+        loop {
+            let op = match self.peek() {
+                Tok::Op('*') => BinOp::Mul,
+                Tok::Op('/') => BinOp::Div,
+                _ => return Some((e, d)),
+            };
+            let col = self.col();
+            self.bump();
+            let (rhs, rd) = self.unary()?;
+            d = self.depth(1 + d.max(rd), col)?;
+            e = Expr::Binary(op, Box::new(e), Box::new(rhs));
+        }
+    }
+
+    fn unary(&mut self) -> Option<(Expr, usize)> {
+        match self.peek() {
+            Tok::Op('-') => {
+                let col = self.col();
+                self.bump();
+                if let Tok::Num(v) = *self.peek() {
+                    self.bump();
+                    return Some((Expr::Num(-v), 1));
+                }
+                if !self.enter() {
+                    return None;
+                }
+                let r = self.unary();
+                self.nest -= 1;
+                let (e, d) = r?;
+                let d = self.depth(d + 1, col)?;
+                Some((Expr::Neg(Box::new(e)), d))
+            }
+            Tok::Op('+') => {
+                self.bump();
+                if !self.enter() {
+                    return None;
+                }
+                let r = self.unary();
+                self.nest -= 1;
+                r
+            }
+            _ => self.primary(),
+        }
+    }
+
+    fn primary(&mut self) -> Option<(Expr, usize)> {
+        let col = self.col();
+        match self.peek().clone() {
+            Tok::Num(v) => {
+                self.bump();
+                Some((Expr::Num(v), 1))
+            }
+            Tok::Op('(') => {
+                self.bump();
+                let e = self.expr()?;
+                if self.peek() != &Tok::Op(')') {
+                    let found = self.describe_current();
+                    self.syntax_error(format!("expected `)`, found {found}"));
+                    return None;
+                }
+                self.bump();
+                Some(e)
+            }
+            Tok::Ident(name) => {
+                self.bump();
+                if self.peek() == &Tok::Op('(') {
+                    self.call(name, col)
+                } else {
+                    self.name(&name, col);
+                    Some((Expr::Name(name), 1))
+                }
+            }
+            _ => {
+                let found = self.describe_current();
+                self.syntax_error(format!("expected a number, a name or `(`, found {found}"));
+                None
+            }
+        }
+    }
+
+    /// Resolves a name that is not called (spec §3.5).
+    fn name(&mut self, name: &str, col: u32) {
+        if Func::from_name(name).is_some() {
+            self.failed = true;
+            self.error_at(
+                DiagnosticCode::FunctionWithoutCall,
+                col,
+                format!("function `{name}` used without a call; write `{name}(…)`"),
+            );
+            return;
+        }
+        match self.cx.symbols.get(name).map(|s| s.kind) {
+            Some(SymKind::Param | SymKind::Unknown) => {}
+            Some(other) => {
+                self.failed = true;
+                self.diags.push(
+                    Diagnostic::new(
+                        DiagnosticCode::NotAParameter,
+                        self.cx.line,
+                        col,
+                        format!("`{name}` is {}, not a parameter", other.describe()),
+                    )
+                    .with_label(self.cx.label)
+                    .with_expected("a parameter name")
+                    .with_found(name),
+                );
+            }
+            None => {
+                self.failed = true;
+                self.diags.push(
+                    Diagnostic::new(
+                        DiagnosticCode::UndefinedName,
+                        self.cx.line,
+                        col,
+                        format!("undefined name `{name}`"),
+                    )
+                    .with_label(self.cx.label)
+                    .with_expected("a declared param or audioParam")
+                    .with_found(name),
+                );
+            }
+        }
+    }
+
+    fn call(&mut self, name: String, col: u32) -> Option<(Expr, usize)> {
+        // At `(`.
+        if !self.enter() {
+            return None;
+        }
+        let r = self.call_inner(name, col);
+        self.nest -= 1;
+        r
+    }
+
+    fn call_inner(&mut self, name: String, col: u32) -> Option<(Expr, usize)> {
+        self.bump();
+        let mut args = Vec::new();
+        let mut d = 0;
+        if self.peek() == &Tok::Op(')') {
+            self.bump();
+        } else {
+            loop {
+                let (a, ad) = self.expr()?;
+                d = d.max(ad);
+                args.push(a);
+                match self.peek() {
+                    Tok::Op(',') => self.bump(),
+                    Tok::Op(')') => {
+                        self.bump();
+                        break;
+                    }
+                    _ => {
+                        let found = self.describe_current();
+                        self.syntax_error(format!(
+                            "expected `,` or `)` in the call of `{name}`, found {found}"
+                        ));
+                        return None;
+                    }
+                }
+            }
+        }
+        let d = self.depth(d + 1, col)?;
+        let Some(func) = Func::from_name(&name) else {
+            self.failed = true;
+            let list: Vec<&str> = Func::ALL.iter().map(|f| f.name()).collect();
+            self.diags.push(
+                Diagnostic::new(
+                    DiagnosticCode::UndefinedName,
+                    self.cx.line,
+                    col,
+                    format!("undefined function `{name}`"),
+                )
+                .with_label(self.cx.label)
+                .with_expected(format!("one of {}", list.join(", ")))
+                .with_found(name),
+            );
+            return Some((Expr::Num(f64::NAN), d));
+        };
+        if args.len() != func.arity() {
+            self.failed = true;
+            self.diags.push(
+                Diagnostic::new(
+                    DiagnosticCode::WrongArity,
+                    self.cx.line,
+                    col,
+                    format!(
+                        "`{name}` takes {} argument{}, found {}",
+                        func.arity(),
+                        if func.arity() == 1 { "" } else { "s" },
+                        args.len()
+                    ),
+                )
+                .with_label(self.cx.label)
+                .with_expected(func.arity().to_string())
+                .with_found(args.len().to_string()),
+            );
+        }
+        Some((Expr::Call(func, args), d))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(s: &str) -> (Option<Expr>, Vec<Diagnostic>) {
+        let mut symbols = Symbols::new();
+        for n in ["a", "b", "kScale"] {
+            symbols.insert(
+                n.to_string(),
+                Symbol {
+                    kind: SymKind::Param,
+                    line: 1,
+                    col: 1,
+                },
+            );
+        }
+        let cx = ExprContext {
+            symbols: &symbols,
+            line: 1,
+            label: None,
+        };
+        let mut d = Diags::default();
+        let chars: Vec<char> = s.chars().collect();
+        let e = parse_expression(&chars, 1, &cx, &mut d);
+        (e, d.finish())
+    }
+
+    #[test]
+    fn precedence_and_folding() {
+        let (e, d) = parse("1 + 2*-a - -3");
+        assert!(d.is_empty(), "{d:?}");
+        assert_eq!(e.unwrap().to_string(), "1 + 2*-a - -3");
+        assert_eq!(parse("-0.2").0, Some(Expr::Num(-0.2)));
+        assert_eq!(parse("-(2)").0, Some(Expr::Neg(Box::new(Expr::Num(2.0)))));
+        assert_eq!(parse("+.5e+1").0, Some(Expr::Num(5.0)));
+        assert_eq!(parse("1.").0, Some(Expr::Num(1.0)));
+    }
+
+    #[test]
+    fn errors() {
+        let (_, d) = parse("a + kScale3");
+        assert_eq!(d[0].code, DiagnosticCode::UndefinedName);
+        assert_eq!(d[0].col, 5);
+        assert_eq!(parse("sqrt").1[0].code, DiagnosticCode::FunctionWithoutCall);
+        assert_eq!(parse("pow(a)").1[0].code, DiagnosticCode::WrongArity);
+        assert_eq!(parse("floor(a)").1[0].code, DiagnosticCode::UndefinedName);
+        assert_eq!(parse("pi").1[0].code, DiagnosticCode::UndefinedName);
+        assert_eq!(parse("1e999").1[0].code, DiagnosticCode::NonFiniteNumber);
+        assert_eq!(parse("40abc").1[0].code, DiagnosticCode::InvalidNumber);
+        assert_eq!(parse("(a").1[0].code, DiagnosticCode::ExpressionSyntax);
+        let deep = "(".repeat(5000) + "1" + &")".repeat(5000);
+        assert_eq!(parse(&deep).1[0].code, DiagnosticCode::ExpressionTooDeep);
+        let long = vec!["1"; 5000].join("-");
+        assert_eq!(parse(&long).1[0].code, DiagnosticCode::ExpressionTooDeep);
+        let unary = "-".repeat(5000) + "a";
+        assert_eq!(parse(&unary).1[0].code, DiagnosticCode::ExpressionTooDeep);
+    }
+
+    #[test]
+    fn literals() {
+        let l = |s: &str| parse_number_literal(&s.chars().collect::<Vec<_>>());
+        assert_eq!(l("-0.2"), Ok(-0.2));
+        assert_eq!(l("+3"), Ok(3.0));
+        assert_eq!(l("1e999"), Err(NumberError::NonFinite));
+        assert_eq!(l("1e"), Err(NumberError::Invalid));
+        assert_eq!(l("a"), Err(NumberError::Invalid));
+        assert_eq!(l(""), Err(NumberError::Invalid));
+    }
+}

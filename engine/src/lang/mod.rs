@@ -1,0 +1,66 @@
+//! The model-language front end (spec §3): parser, diagnostics and canonical printer.
+//!
+//! ```
+//! use ressort_engine::lang::{parse, print};
+//! let parsed = parse("@K param 0.1\n@o osc 1. K 0.0003 0. 0.  # a comment\n@out1 posOutput @o\n");
+//! assert!(parsed.diagnostics.is_empty());
+//! let spec = parsed.spec.unwrap();
+//! assert_eq!(parse(&print(&spec)).spec, Some(spec));
+//! ```
+//!
+//! * [`parse`] / [`parse_bytes`] read a script into a [`crate::ModelSpec`], collecting every
+//!   [`Diagnostic`] in one pass with its line and column (§3.12 f). The spec is produced only
+//!   when there is no error; warnings do not block it.
+//! * [`print`] writes canonical script text that parses back to the same spec.
+//!
+//! The language is a superset of MIMS4Max (§3.12 a): `#` comments anywhere, scientific
+//! notation, expressions with the functions of §3.5, legacy `massG`, two-parameter `spring` and
+//! `nlSpring`, `~samplerate raw|scaled`, nested and overlapping buffer scopes (§3.10) and legacy
+//! trailing buffer tags (§6.4).
+
+mod diagnostics;
+mod expr_parser;
+mod lexer;
+mod parser;
+mod printer;
+
+pub use diagnostics::{Diagnostic, DiagnosticCode, Severity, MAX_DIAGNOSTICS};
+pub use expr_parser::MAX_NESTING;
+pub use parser::{parse, parse_bytes, MAX_MACRO_NODES, MAX_OPEN_SCOPES};
+pub use printer::print;
+
+use crate::spec::ModelSpec;
+
+/// The result of parsing a script.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Parsed {
+    /// The model, when the script has no error (warnings do not block it).
+    pub spec: Option<ModelSpec>,
+    /// Every error and warning, sorted by line and column.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Parsed {
+    /// True when the script has no error.
+    pub fn is_ok(&self) -> bool {
+        self.spec.is_some()
+    }
+
+    /// The errors.
+    pub fn errors(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.diagnostics.iter().filter(|d| d.is_error())
+    }
+
+    /// The warnings.
+    pub fn warnings(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.diagnostics.iter().filter(|d| !d.is_error())
+    }
+
+    /// The spec, or every diagnostic when there is an error.
+    pub fn into_result(self) -> Result<ModelSpec, Vec<Diagnostic>> {
+        match self.spec {
+            Some(spec) => Ok(spec),
+            None => Err(self.diagnostics),
+        }
+    }
+}
