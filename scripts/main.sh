@@ -1,7 +1,16 @@
 #!/usr/bin/env bash
-# Sets up and runs the main job: measures the reference models of the specification (spec §7)
-# on the engine and prints the table (ns per sample, % of one core at 48 kHz, compile time).
+# Sets up and runs the main job on a machine with no audio device: checks, renders and
+# benchmarks reference models with the `ressort` command line, then measures every reference
+# model of the specification (spec §7) on the engine. Extra arguments go to the engine
+# benchmark (`--save` writes engine/benches/RESULTS.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+cargo build --release --locked -p ressort-cli
+ressort=target/release/ressort
+mkdir -p out
+"$ressort" check models/mesh-25x20.mdl
+"$ressort" render models/mesh-25x20.mdl -o out/mesh-25x20.wav --seconds 3 --impulse in1=-0.01
+"$ressort" render models/string-1000.mdl -o out/string-1000.wav --seconds 3 --impulse in1=-0.01
+"$ressort" bench models/string-1000.mdl
 cargo bench -p ressort-engine --bench reference_models --locked -- "$@"

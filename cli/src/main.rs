@@ -1,0 +1,435 @@
+//! `ressort`: check, render and benchmark mass-interaction models from the command line.
+//!
+//! ```text
+//! ressort check MODEL.mdl
+//! ressort render MODEL.mdl -o OUT.wav [--sample-rate HZ] [--samples N | --seconds S]
+//!                [--input inK=FILE.wav]… [--impulse inK=AMPLITUDE]… [--set NAME=VALUE]…
+//! ressort bench MODEL.mdl [--sample-rate HZ] [--seconds S]
+//! ```
+//!
+//! Exit status: 0 for success, 1 when the model has errors, 2 for usage and I/O errors.
+
+mod report;
+
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use ressort_engine::{compile, parse_bytes, CompileOptions, Engine, InputUse, ModelSpec};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "ressort",
+    version,
+    about = "Check, render and benchmark mass-interaction models"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Parse and compile a model; print its diagnostics, summary and stability report.
+    Check(CheckArgs),
+    /// Render a model's outputs to a 32-bit float WAV file, one channel per @outN.
+    Render(RenderArgs),
+    /// Measure a model: parse and compile time, then time per sample with no I/O.
+    Bench(BenchArgs),
+}
+
+#[derive(Args, Debug)]
+struct CheckArgs {
+    /// The model script.
+    model: PathBuf,
+    /// The sample rate the stability analysis assumes, in Hz.
+    #[arg(long, default_value_t = 44_100.0)]
+    sample_rate: f64,
+}
+
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// The model script.
+    model: PathBuf,
+    /// The WAV file to write.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Sample rate in Hz (an integer, as WAV files need).
+    #[arg(long, default_value_t = 44_100)]
+    sample_rate: u32,
+    /// Length in samples.
+    #[arg(long, conflicts_with = "seconds")]
+    samples: Option<u64>,
+    /// Length in seconds (default 2).
+    #[arg(long, allow_hyphen_values = true)]
+    seconds: Option<f64>,
+    /// Feed a WAV file to input K: `in2=pluck.wav`. Its first channel is used.
+    #[arg(long = "input", value_name = "inK=FILE.wav")]
+    inputs: Vec<String>,
+    /// Put AMPLITUDE at sample 0 of input K: `in1=-0.01`.
+    #[arg(
+        long = "impulse",
+        value_name = "inK=AMPLITUDE",
+        allow_hyphen_values = true
+    )]
+    impulses: Vec<String>,
+    /// Set a control parameter before rendering: `K=0.2`.
+    #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
+    sets: Vec<String>,
+}
+
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// The model script.
+    model: PathBuf,
+    /// Sample rate in Hz.
+    #[arg(long, default_value_t = 48_000.0)]
+    sample_rate: f64,
+    /// Simulated duration in seconds.
+    #[arg(long, default_value_t = 5.0)]
+    seconds: f64,
+}
+
+/// Why a command failed: bad model (exit 1) or usage / I/O (exit 2). The message is printed
+/// by `main`; model diagnostics are printed where they are found.
+#[derive(Debug)]
+enum Failure {
+    Model,
+    Usage(String),
+}
+
+fn usage(msg: impl Into<String>) -> Failure {
+    Failure::Usage(msg.into())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Check(a) => check(&a),
+        Command::Render(a) => render(&a),
+        Command::Bench(a) => bench(&a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Model) => ExitCode::from(1),
+        Err(Failure::Usage(msg)) => {
+            eprintln!("ressort: {msg}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Reads and parses a model, printing its diagnostics as `FILE:LINE:COL: severity: message`.
+fn load(path: &Path) -> Result<ModelSpec, Failure> {
+    let bytes =
+        std::fs::read(path).map_err(|e| usage(format!("cannot read {}: {e}", path.display())))?;
+    let parsed = parse_bytes(&bytes);
+    for d in &parsed.diagnostics {
+        eprintln!("{}:{d}", path.display());
+    }
+    parsed.spec.ok_or(Failure::Model)
+}
+
+/// Compiles a spec, printing compile errors with their location.
+fn build(path: &Path, spec: &ModelSpec, sample_rate_hz: f64) -> Result<Engine, Failure> {
+    if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
+        return Err(usage(format!(
+            "invalid sample rate {sample_rate_hz}: it must be a positive number of Hz"
+        )));
+    }
+    compile(spec, &CompileOptions::at(sample_rate_hz)).map_err(|errors| {
+        for e in &errors.0 {
+            report::print_compile_error(path, e);
+        }
+        Failure::Model
+    })
+}
+
+fn check(a: &CheckArgs) -> Result<(), Failure> {
+    let spec = load(&a.model)?;
+    let mut engine = build(&a.model, &spec, a.sample_rate)?;
+    let stability = engine.stability();
+    report::print_stability_warnings(&a.model, &spec, &engine, &stability);
+    print!("{}", report::summary(&a.model, &spec, &engine, &stability));
+    Ok(())
+}
+
+/// Splits `inK=VALUE` into the 0-based channel and the value text.
+fn input_assignment<'a>(text: &'a str, engine: &Engine) -> Result<(usize, &'a str), Failure> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| usage(format!("expected inK=VALUE, found `{text}`")))?;
+    let channel: usize = name
+        .strip_prefix("in")
+        .and_then(|n| n.parse().ok())
+        .filter(|n| *n >= 1)
+        .ok_or_else(|| usage(format!("`{name}` is not an input name such as in1")))?;
+    let count = engine.info().num_inputs();
+    if channel > count {
+        let have = if count == 0 {
+            "the model has no inputs".to_string()
+        } else {
+            format!("the model's inputs are in1..in{count}")
+        };
+        return Err(usage(format!("unknown input `{name}`: {have}")));
+    }
+    Ok((channel - 1, value))
+}
+
+/// Reads the first channel of a WAV file as f64 in [−1, 1] (integers) or as stored (floats).
+fn read_wav(path: &Path, sample_rate: u32) -> Result<Vec<f64>, Failure> {
+    let mut reader = hound::WavReader::open(path)
+        .map_err(|e| usage(format!("cannot read {}: {e}", path.display())))?;
+    let spec = reader.spec();
+    if spec.sample_rate != sample_rate {
+        return Err(usage(format!(
+            "{} is at {} Hz but the render runs at {sample_rate} Hz; resample it or pass \
+             --sample-rate {}",
+            path.display(),
+            spec.sample_rate,
+            spec.sample_rate
+        )));
+    }
+    if spec.channels > 1 {
+        eprintln!(
+            "ressort: note: {} has {} channels; using the first",
+            path.display(),
+            spec.channels
+        );
+    }
+    let step = spec.channels.max(1) as usize;
+    let bad = |e: hound::Error| usage(format!("cannot decode {}: {e}", path.display()));
+    let samples: Vec<f64> = match spec.sample_format {
+        hound::SampleFormat::Float => reader
+            .samples::<f32>()
+            .step_by(step)
+            .map(|s| s.map(f64::from))
+            .collect::<Result<_, _>>()
+            .map_err(bad)?,
+        hound::SampleFormat::Int => {
+            let scale = 1.0 / (1u64 << (spec.bits_per_sample.clamp(1, 32) - 1)) as f64;
+            reader
+                .samples::<i32>()
+                .step_by(step)
+                .map(|s| s.map(|v| v as f64 * scale))
+                .collect::<Result<_, _>>()
+                .map_err(bad)?
+        }
+    };
+    Ok(samples)
+}
+
+/// The maximum length of a render: one hour at 192 kHz.
+const MAX_RENDER_SAMPLES: u64 = 192_000 * 3600;
+const RENDER_BLOCK_FRAMES: usize = 4096;
+
+fn render(a: &RenderArgs) -> Result<(), Failure> {
+    let sr = a.sample_rate;
+    if sr == 0 {
+        return Err(usage(
+            "invalid --sample-rate 0: it must be a positive number of Hz",
+        ));
+    }
+    let total = match (a.samples, a.seconds) {
+        (Some(n), _) => n,
+        (None, Some(s)) if s.is_finite() && s >= 0.0 => (s * sr as f64).round() as u64,
+        (None, Some(s)) => return Err(usage(format!("invalid --seconds {s}"))),
+        (None, None) => 2 * sr as u64,
+    };
+    if total > MAX_RENDER_SAMPLES {
+        return Err(usage(format!(
+            "{total} samples is longer than the limit of {MAX_RENDER_SAMPLES} (one hour at 192 kHz)"
+        )));
+    }
+    let spec = load(&a.model)?;
+    let mut engine = build(&a.model, &spec, sr as f64)?;
+    let info = engine.info().clone();
+    if info.num_outputs() == 0 {
+        return Err(usage(format!(
+            "{} has no outputs (@outN) to render",
+            a.model.display()
+        )));
+    }
+
+    for s in &a.sets {
+        let (name, value) = s
+            .split_once('=')
+            .ok_or_else(|| usage(format!("expected NAME=VALUE, found `{s}`")))?;
+        let v: f64 = value
+            .parse()
+            .map_err(|_| usage(format!("`{value}` is not a number (in --set {s})")))?;
+        let id = engine.param_id(name).ok_or_else(|| {
+            let names: Vec<&str> = info
+                .params
+                .iter()
+                .filter(|p| p.audio_input.is_none())
+                .map(|p| p.name.as_str())
+                .collect();
+            usage(format!(
+                "unknown parameter `{name}`; the model's parameters are: {}",
+                if names.is_empty() {
+                    "(none)".to_string()
+                } else {
+                    names.join(", ")
+                }
+            ))
+        })?;
+        engine
+            .set_param(id, v)
+            .map_err(|e| usage(format!("cannot set `{name}`: {e}")))?;
+    }
+
+    // Input signals, each as long as it is; missing samples are 0.
+    let mut inputs: Vec<Vec<f64>> = vec![Vec::new(); info.num_inputs()];
+    for s in &a.inputs {
+        let (ch, file) = input_assignment(s, &engine)?;
+        inputs[ch] = read_wav(Path::new(file), sr)?;
+    }
+    for s in &a.impulses {
+        let (ch, value) = input_assignment(s, &engine)?;
+        let v: f64 = value
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| {
+                usage(format!(
+                    "`{value}` is not a finite number (in --impulse {s})"
+                ))
+            })?;
+        if inputs[ch].is_empty() {
+            inputs[ch].push(0.0);
+        }
+        inputs[ch][0] += v;
+    }
+
+    let out_channels = info.num_outputs();
+    let wav_spec = hound::WavSpec {
+        channels: out_channels as u16,
+        sample_rate: sr,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    let io = |e: hound::Error| usage(format!("cannot write {}: {e}", a.output.display()));
+    let mut writer = hound::WavWriter::create(&a.output, wav_spec).map_err(io)?;
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} rendering [{bar:40}] {percent}% {eta} left")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    if total < 10 * sr as u64 {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let mut in_buf = vec![0.0; info.num_inputs() * RENDER_BLOCK_FRAMES];
+    let mut out_buf = vec![0.0; out_channels * RENDER_BLOCK_FRAMES];
+    let mut done: u64 = 0;
+    let mut peak = 0.0f64;
+    while done < total {
+        let len = RENDER_BLOCK_FRAMES.min((total - done) as usize);
+        for (c, signal) in inputs.iter().enumerate() {
+            for n in 0..len {
+                in_buf[c * len + n] = signal.get(done as usize + n).copied().unwrap_or(0.0);
+            }
+        }
+        engine.process(
+            len,
+            &in_buf[..info.num_inputs() * len],
+            &mut out_buf[..out_channels * len],
+        );
+        for n in 0..len {
+            for c in 0..out_channels {
+                let v = out_buf[c * len + n];
+                peak = peak.max(v.abs());
+                writer.write_sample(v as f32).map_err(io)?;
+            }
+        }
+        done += len as u64;
+        bar.set_position(done);
+    }
+    bar.finish_and_clear();
+    writer.finalize().map_err(io)?;
+    if let Some(ev) = engine.guard_event() {
+        eprintln!(
+            "ressort: warning: the model blew up at sample {} ({:?}{}); the output is silent \
+             from there. Run `ressort check` for its stability report.",
+            ev.sample,
+            ev.kind,
+            ev.point
+                .map(|p| format!(" at {}", info.point_label(p as usize)))
+                .unwrap_or_default()
+        );
+    }
+    eprintln!(
+        "wrote {}: {} samples at {} Hz, {} channel(s), peak {:.3e}",
+        a.output.display(),
+        total,
+        sr,
+        out_channels,
+        peak
+    );
+    Ok(())
+}
+
+fn bench(a: &BenchArgs) -> Result<(), Failure> {
+    if !(a.seconds.is_finite() && a.seconds > 0.0 && a.seconds <= 3600.0) {
+        return Err(usage(format!(
+            "invalid --seconds {}: it must be in (0, 3600]",
+            a.seconds
+        )));
+    }
+    let bytes = std::fs::read(&a.model)
+        .map_err(|e| usage(format!("cannot read {}: {e}", a.model.display())))?;
+    let start = Instant::now();
+    let parsed = parse_bytes(&bytes);
+    let spec = match parsed.spec {
+        Some(spec) => spec,
+        None => {
+            for d in &parsed.diagnostics {
+                eprintln!("{}:{d}", a.model.display());
+            }
+            return Err(Failure::Model);
+        }
+    };
+    let mut engine = build(&a.model, &spec, a.sample_rate)?;
+    let compile_ms = start.elapsed().as_secs_f64() * 1e3;
+
+    let block = 64;
+    let n_in = engine.info().num_inputs();
+    let n_out = engine.info().num_outputs();
+    let total = (a.seconds * a.sample_rate).round().max(1.0) as u64;
+    let mut first = vec![0.0; n_in * block];
+    if matches!(
+        engine.info().inputs.first().and_then(|u| u.first()),
+        Some(InputUse::Force(_))
+    ) {
+        first[0] = -0.01;
+    }
+    let rest = vec![0.0; n_in * block];
+    let mut out = vec![0.0; n_out * block];
+    let t = Instant::now();
+    let mut done = 0u64;
+    let mut blocks = 0u64;
+    while done < total {
+        let input = if blocks == 0 { &first } else { &rest };
+        engine.process(block, input, &mut out);
+        done += block as u64;
+        blocks += 1;
+    }
+    let ns_per_sample = t.elapsed().as_secs_f64() * 1e9 / done as f64;
+    let realtime_factor = 1e9 / a.sample_rate / ns_per_sample;
+    eprintln!(
+        "{}: {} samples at {} Hz, {:.2} % of one core",
+        a.model.display(),
+        done,
+        a.sample_rate,
+        100.0 / realtime_factor
+    );
+    println!(
+        "ns_per_sample={ns_per_sample:.3} realtime_factor={realtime_factor:.3} points={} \
+         interactions={} compile_ms={compile_ms:.3}",
+        engine.info().num_points,
+        engine.info().num_interactions
+    );
+    Ok(())
+}

@@ -1,0 +1,259 @@
+//! The `ressort` binary as a user runs it: exit codes, diagnostics format, WAV output, bench line.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const STRING_1000: &str = "\
+# 1000-mass string (canonical definition, spec §7.10)
+@K param 0.1
+@Z param 0.001
+@s string 1002 1. K Z 0. 0.
+@gh ground 0.1
+@h mass 1. 0.1 0.
+@sh springDamper @gh @h 0.0001 0.05
+@hit contact [@s 0.13] @h 0.1 0.001
+@in1 frcInput @h
+@out1 posOutput [@s 0.77]
+";
+
+fn ressort(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ressort"))
+        .args(args)
+        .output()
+        .expect("run ressort")
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+#[test]
+fn check_valid_model_prints_summary_and_exits_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(dir.path(), "s.mdl", STRING_1000);
+    let out = ressort(&["check", model.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("points        1004"), "{stdout}");
+    assert!(stdout.contains("interactions  1003"), "{stdout}");
+    assert!(stdout.contains("stable"), "{stdout}");
+}
+
+#[test]
+fn check_reports_errors_with_file_line_col_and_exits_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(
+        dir.path(),
+        "bad.mdl",
+        "@o osc 1. 0.1 0.0003 0. 0.\n@sp springDamper @o @nowhere 0.1 0.1\n@out1 posOutput @o\n",
+    );
+    let out = ressort(&["check", model.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = text(&out.stderr);
+    let expected = format!("{}:2:21: error:", model.display());
+    assert!(stderr.contains(&expected), "{stderr}");
+    assert!(stderr.contains("nowhere"), "{stderr}");
+}
+
+#[test]
+fn check_reports_stability_warnings_at_the_element_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(
+        dir.path(),
+        "u.mdl",
+        "@K param 5\n@o osc 1. K 0. 0. 0.\n@out1 posOutput @o\n",
+    );
+    let out = ressort(&["check", model.to_str().unwrap()]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "a stability warning is not an error"
+    );
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains(&format!("{}:2:1: warning:", model.display())),
+        "{stderr}"
+    );
+    assert!(text(&out.stdout).contains("UNSTABLE"));
+}
+
+#[test]
+fn usage_and_io_errors_exit_2() {
+    assert_eq!(
+        ressort(&["check", "/nonexistent/model.mdl"]).status.code(),
+        Some(2)
+    );
+    assert_eq!(ressort(&["frobnicate"]).status.code(), Some(2));
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(dir.path(), "s.mdl", STRING_1000);
+    let m = model.to_str().unwrap();
+    let wav = dir.path().join("o.wav");
+    let w = wav.to_str().unwrap();
+    for args in [
+        vec!["render", m, "-o", w, "--sample-rate", "0"],
+        vec!["render", m, "-o", w, "--impulse", "in7=1"],
+        vec!["render", m, "-o", w, "--set", "nope=1"],
+        vec!["render", m, "-o", w, "--set", "K=abc"],
+        vec!["render", m, "-o", w, "--input", "in1=/nonexistent.wav"],
+        vec!["render", m, "-o", w, "--seconds", "-1"],
+    ] {
+        let out = ressort(&args);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+        assert!(text(&out.stderr).starts_with("ressort: "), "{args:?}");
+    }
+}
+
+#[test]
+fn render_writes_one_float_channel_per_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(dir.path(), "s.mdl", STRING_1000);
+    let wav = dir.path().join("o.wav");
+    let out = ressort(&[
+        "render",
+        model.to_str().unwrap(),
+        "-o",
+        wav.to_str().unwrap(),
+        "--sample-rate",
+        "48000",
+        "--samples",
+        "9600",
+        "--impulse",
+        "in1=-0.01",
+        "--set",
+        "K=0.2",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let reader = hound::WavReader::open(&wav).unwrap();
+    let spec = reader.spec();
+    assert_eq!(spec.channels, 1);
+    assert_eq!(spec.sample_rate, 48_000);
+    assert_eq!(spec.bits_per_sample, 32);
+    assert_eq!(spec.sample_format, hound::SampleFormat::Float);
+    let samples: Vec<f32> = reader.into_samples().map(Result::unwrap).collect();
+    assert_eq!(samples.len(), 9600);
+    assert!(samples.iter().all(|v| v.is_finite()));
+    assert!(
+        samples.iter().any(|v| v.abs() > 1e-5),
+        "the struck string is silent"
+    );
+
+    // Without the impulse the model stays at rest.
+    let quiet = dir.path().join("q.wav");
+    let out = ressort(&[
+        "render",
+        model.to_str().unwrap(),
+        "-o",
+        quiet.to_str().unwrap(),
+        "--samples",
+        "1000",
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let r = hound::WavReader::open(&quiet).unwrap();
+    assert!(r.into_samples::<f32>().all(|v| v.unwrap() == 0.0));
+}
+
+#[test]
+fn render_feeds_wav_inputs() {
+    // A force signal from a file drives the hammer like the impulse does.
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(dir.path(), "s.mdl", STRING_1000);
+    let force = dir.path().join("f.wav");
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: 44_100,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    let mut w = hound::WavWriter::create(&force, spec).unwrap();
+    w.write_sample(-0.01f32).unwrap();
+    for _ in 0..99 {
+        w.write_sample(0.0f32).unwrap();
+    }
+    w.finalize().unwrap();
+    let a = dir.path().join("a.wav");
+    let b = dir.path().join("b.wav");
+    let m = model.to_str().unwrap();
+    let input = format!("in1={}", force.display());
+    assert!(ressort(&[
+        "render",
+        m,
+        "-o",
+        a.to_str().unwrap(),
+        "--samples",
+        "4000",
+        "--input",
+        &input
+    ])
+    .status
+    .success());
+    assert!(ressort(&[
+        "render",
+        m,
+        "-o",
+        b.to_str().unwrap(),
+        "--samples",
+        "4000",
+        "--impulse",
+        "in1=-0.01"
+    ])
+    .status
+    .success());
+    let read = |p: &Path| -> Vec<f32> {
+        hound::WavReader::open(p)
+            .unwrap()
+            .into_samples()
+            .map(Result::unwrap)
+            .collect()
+    };
+    // −0.01 as f32 then widened differs slightly from the f64 literal; compare closely.
+    let (x, y) = (read(&a), read(&b));
+    let peak = y.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+    assert!(peak > 1e-5);
+    for (p, q) in x.iter().zip(&y) {
+        assert!((p - q).abs() <= 1e-5 * peak, "{p} vs {q}");
+    }
+}
+
+#[test]
+fn bench_ends_with_the_machine_readable_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(dir.path(), "s.mdl", STRING_1000);
+    let out = ressort(&["bench", model.to_str().unwrap(), "--seconds", "0.05"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let last = stdout.lines().last().unwrap();
+    let fields: Vec<(&str, &str)> = last
+        .split(' ')
+        .map(|kv| kv.split_once('=').unwrap())
+        .collect();
+    let keys: Vec<&str> = fields.iter().map(|f| f.0).collect();
+    assert_eq!(
+        keys,
+        [
+            "ns_per_sample",
+            "realtime_factor",
+            "points",
+            "interactions",
+            "compile_ms"
+        ]
+    );
+    for (k, v) in &fields {
+        let x: f64 = v
+            .parse()
+            .unwrap_or_else(|_| panic!("{k}={v} is not a number"));
+        assert!(x.is_finite() && x > 0.0, "{k}={v}");
+    }
+    assert_eq!(fields[2].1, "1004");
+    assert_eq!(fields[3].1, "1003");
+}
