@@ -340,18 +340,20 @@ impl Proxies {
         }
     }
 
+    /// The interpolated position of proxy `i`: Σ w·x_node (spec §2.8).
+    #[inline(always)]
+    fn interpolate(&self, i: usize, x: &[f64]) -> f64 {
+        let [n0, n1, n2, n3] = self.nodes[i];
+        let [w0, w1, w2, w3] = self.weights[i];
+        w0 * x[n0 as usize] + w1 * x[n1 as usize] + w2 * x[n2 as usize] + w3 * x[n3 as usize]
+    }
+
     /// Stage 3: x̃_P ← x_P, x_P ← Σ w·x_node. The force slot is cleared here, after stage 6 of
     /// the previous step read it (it holds F_P for `frcOutput`, spec §3.12 e).
     #[inline]
     fn update_positions(&self, p: &mut Points) {
         for i in 0..self.len() {
-            let [n0, n1, n2, n3] = self.nodes[i];
-            let [w0, w1, w2, w3] = self.weights[i];
-            let x = &p.x;
-            let pos = w0 * x[n0 as usize]
-                + w1 * x[n1 as usize]
-                + w2 * x[n2 as usize]
-                + w3 * x[n3 as usize];
+            let pos = self.interpolate(i, &p.x);
             let k = self.base + i;
             p.xp[k] = p.x[k];
             p.x[k] = pos;
@@ -807,13 +809,7 @@ impl Engine {
         }
         // Connection points start at their interpolated position with no velocity.
         for i in 0..self.proxies.len() {
-            let [n0, n1, n2, n3] = self.proxies.nodes[i];
-            let [w0, w1, w2, w3] = self.proxies.weights[i];
-            let x = &self.points.x;
-            let pos = w0 * x[n0 as usize]
-                + w1 * x[n1 as usize]
-                + w2 * x[n2 as usize]
-                + w3 * x[n3 as usize];
+            let pos = self.proxies.interpolate(i, &self.points.x);
             let k = self.proxies.base + i;
             self.points.x[k] = pos;
             self.points.xp[k] = pos;
@@ -978,26 +974,26 @@ impl Engine {
     ) -> Option<(GuardKind, u32)> {
         let limit = self.position_limit;
         let mut bad = None;
-        let mut put = |r: &Route, v: f64| {
-            let ch = r.channel as usize;
+        let mut put = |channel: u32, v: f64| {
+            let ch = channel as usize;
             if ch < out_channels {
                 outputs[ch * frames + n] = v;
             }
             if bad.is_none() {
                 if !v.is_finite() {
-                    bad = Some((GuardKind::NonFinite, r.channel));
+                    bad = Some((GuardKind::NonFinite, channel));
                 } else if v.abs() > limit {
-                    bad = Some((GuardKind::Runaway, r.channel));
+                    bad = Some((GuardKind::Runaway, channel));
                 }
             }
         };
         for r in &self.pos_outputs {
-            put(r, self.points.x[r.index as usize]);
+            put(r.channel, self.points.x[r.index as usize]);
         }
         for &(channel, start, len) in &self.frc_outputs {
             let sources = &self.frc_sources[start as usize..(start + len) as usize];
             let total = sources.iter().map(|&p| self.points.f[p as usize]).sum();
-            put(&Route { channel, index: 0 }, total);
+            put(channel, total);
         }
         bad
     }
