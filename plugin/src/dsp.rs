@@ -1,0 +1,162 @@
+//! The output stage: DC filter, soft ceiling, smoothing and the tuning law.
+
+use std::f64::consts::PI;
+
+/// The high-pass of the mi-gen example patches (spec §7.0): y = x − onepole₄₀(x).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DcBlocker {
+    state: f64,
+    coefficient: f64,
+}
+
+impl DcBlocker {
+    pub const CUTOFF_HZ: f64 = 40.0;
+
+    pub fn new(sample_rate: f64) -> DcBlocker {
+        DcBlocker {
+            state: 0.0,
+            coefficient: 1.0 - (-2.0 * PI * Self::CUTOFF_HZ / sample_rate).exp(),
+        }
+    }
+
+    #[inline]
+    pub fn process(&mut self, x: f64) -> f64 {
+        self.state += self.coefficient * (x - self.state);
+        x - self.state
+    }
+
+    pub fn reset(&mut self) {
+        self.state = 0.0;
+    }
+}
+
+/// Knee of the soft ceiling: below it the output is untouched.
+pub const CEILING_KNEE: f64 = 0.5;
+
+/// The soft ceiling: identity up to the knee, then a tanh curve that approaches ±1 and never
+/// exceeds it. Continuous with a continuous slope. Non-finite input gives 0.
+#[inline]
+pub fn soft_ceiling(x: f64) -> f64 {
+    if !x.is_finite() {
+        return 0.0;
+    }
+    let a = x.abs();
+    if a <= CEILING_KNEE {
+        x
+    } else {
+        let room = 1.0 - CEILING_KNEE;
+        (CEILING_KNEE + room * ((a - CEILING_KNEE) / room).tanh()).copysign(x)
+    }
+}
+
+/// Decibels to a linear gain.
+#[inline]
+pub fn db_to_gain(db: f64) -> f64 {
+    10f64.powf(db / 20.0)
+}
+
+/// A one-pole smoother advanced once per chunk of `chunk` samples.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ChunkSmoother {
+    pub value: f64,
+    coefficient: f64,
+}
+
+impl ChunkSmoother {
+    /// `time_ms` is the time constant.
+    pub fn new(sample_rate: f64, chunk: usize, time_ms: f64, value: f64) -> ChunkSmoother {
+        let samples = (time_ms * 1e-3 * sample_rate).max(1.0);
+        ChunkSmoother {
+            value,
+            coefficient: 1.0 - (-(chunk as f64) / samples).exp(),
+        }
+    }
+
+    /// Moves towards `target`; snaps when within a relative 1e-9 so the value settles.
+    #[inline]
+    pub fn next(&mut self, target: f64) -> f64 {
+        let d = target - self.value;
+        if d.abs() <= 1e-9 * target.abs().max(1e-12) {
+            self.value = target;
+        } else {
+            self.value += self.coefficient * d;
+        }
+        self.value
+    }
+}
+
+/// The Stiffness gain that moves a mode from `f_hz` by `semitones` under the exact discrete
+/// law sin²(πf/SR) = K/4M (spec §5.3): (sin(πf'/SR) / sin(πf/SR))², f' = f·2^(st/12).
+/// Without a reference pitch the low-frequency limit 2^(st/6) applies. f' is kept below
+/// 0.49·SR, where the law stops being monotonic.
+pub fn tuning_gain(semitones: f64, f_hz: Option<f64>, sample_rate: f64) -> f64 {
+    let ratio = 2f64.powf(semitones / 12.0);
+    match f_hz {
+        Some(f) if f > 0.0 && f < 0.49 * sample_rate => {
+            let target = (f * ratio).min(0.49 * sample_rate);
+            let s0 = (PI * f / sample_rate).sin();
+            let s1 = (PI * target / sample_rate).sin();
+            (s1 / s0).powi(2)
+        }
+        _ => ratio * ratio,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ceiling_is_continuous_bounded_and_monotonic() {
+        let mut last = -2.0;
+        for i in -4000..=4000 {
+            let x = i as f64 * 0.005;
+            let y = soft_ceiling(x);
+            assert!(y.abs() <= 1.0, "{x} -> {y}");
+            assert!(y >= last, "not monotonic at {x}");
+            last = y;
+        }
+        assert_eq!(soft_ceiling(0.3), 0.3);
+        assert!((soft_ceiling(CEILING_KNEE + 1e-9) - CEILING_KNEE).abs() < 1e-8);
+        assert_eq!(soft_ceiling(f64::NAN), 0.0);
+        assert_eq!(soft_ceiling(f64::INFINITY), 0.0);
+        assert!(soft_ceiling(1e300) <= 1.0);
+    }
+
+    #[test]
+    fn dc_blocker_removes_a_constant_and_passes_audio() {
+        let sr = 48_000.0;
+        let mut dc = DcBlocker::new(sr);
+        let mut y = 0.0;
+        for _ in 0..48_000 {
+            y = dc.process(1.0);
+        }
+        assert!(y.abs() < 1e-6, "{y}");
+        let mut dc = DcBlocker::new(sr);
+        let mut peak: f64 = 0.0;
+        for n in 0..48_000 {
+            let x = (2.0 * PI * 1000.0 * n as f64 / sr).sin();
+            let y = dc.process(x);
+            if n > 24_000 {
+                peak = peak.max(y.abs());
+            }
+        }
+        assert!((peak - 1.0).abs() < 0.01, "1 kHz passes at {peak}");
+    }
+
+    #[test]
+    fn tuning_follows_the_exact_discrete_law() {
+        let sr = 48_000.0;
+        for &f in &[100.0, 1000.0, 5000.0] {
+            for &st in &[-12.0, 7.0, 12.0] {
+                let g = tuning_gain(st, Some(f), sr);
+                // A mass-spring oscillator: sin²(πf/SR) = K/4M, so f ∝ asin(√(gK/4M)).
+                let k_over_4m = (PI * f / sr).sin().powi(2);
+                let f_new = (g * k_over_4m).sqrt().asin() * sr / PI;
+                let expected = f * 2f64.powf(st / 12.0);
+                assert!((f_new / expected - 1.0).abs() < 1e-9, "{f} {st}: {f_new}");
+            }
+        }
+        assert!((tuning_gain(12.0, None, sr) - 4.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,87 @@
+//! What a script tells the plugin beyond the physics: input routing, the MIDI note target,
+//! the reference pitch and key, and macro ranges.
+
+use ressort_engine::ModelSpec;
+
+/// A host audio channel that can feed a model input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputSource {
+    MainLeft,
+    MainRight,
+    SidechainLeft,
+    SidechainRight,
+    /// Fed by nothing (only MIDI, when it is the note input).
+    Silent,
+}
+
+impl InputSource {
+    /// The default order: `@in1`, `@in2`… take the main input's left and right channels when
+    /// the plugin has a main input (effect layout), then the sidechain's.
+    pub fn default_order(has_main_input: bool) -> &'static [InputSource] {
+        if has_main_input {
+            &[
+                InputSource::MainLeft,
+                InputSource::MainRight,
+                InputSource::SidechainLeft,
+                InputSource::SidechainRight,
+            ]
+        } else {
+            &[InputSource::SidechainLeft, InputSource::SidechainRight]
+        }
+    }
+
+    /// Index into the plugin's per-chunk host channel scratch.
+    pub fn channel(self) -> Option<usize> {
+        match self {
+            InputSource::MainLeft => Some(0),
+            InputSource::MainRight => Some(1),
+            InputSource::SidechainLeft => Some(2),
+            InputSource::SidechainRight => Some(3),
+            InputSource::Silent => None,
+        }
+    }
+}
+
+/// A macro range declared by the script.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MacroRange {
+    pub name: String,
+    pub min: f64,
+    pub max: f64,
+}
+
+/// The plugin-facing settings of a model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HostSettings {
+    /// Per model input (index 0 = `@in1`): the host channel chosen by the script.
+    pub routing: Vec<Option<InputSource>>,
+    /// The model input (0-based) that MIDI notes strike; default: the first force input.
+    pub note_input: Option<u32>,
+    /// The force of a full-velocity note, before the Force gain.
+    pub note_force: f64,
+    /// The model's pitch in Hz at its reference key, when the script declares it.
+    pub reference_pitch_hz: Option<f64>,
+    /// The MIDI key at which the model sounds as written.
+    pub reference_key: f64,
+    pub macro_ranges: Vec<MacroRange>,
+}
+
+impl Default for HostSettings {
+    fn default() -> Self {
+        HostSettings {
+            routing: Vec::new(),
+            note_input: None,
+            note_force: -0.02,
+            reference_pitch_hz: None,
+            reference_key: 60.0,
+            macro_ranges: Vec::new(),
+        }
+    }
+}
+
+impl HostSettings {
+    /// Reads the settings of a parsed model.
+    pub fn from_spec(_spec: &ModelSpec) -> Result<HostSettings, Vec<String>> {
+        Ok(HostSettings::default())
+    }
+}

@@ -1,0 +1,676 @@
+#![allow(missing_debug_implementations)] // nice-plug parameter and plugin types have no Debug.
+
+//! Ressort as a CLAP and VST3 plugin and a standalone application.
+//!
+//! The audio thread runs the engine of `ressort-engine` in chunks of [`model::CHUNK`]
+//! samples. Models are prepared elsewhere ([`model::ModelStore`]) and arrive through a
+//! lock-free channel; the plugin crossfades from the old model to the new one and hands the
+//! old one back to be freed off the audio thread. Host gains (Stiffness, Damping, Tune, MIDI
+//! pitch) are clamped to what the model's stability analysis allows.
+
+use model::{InputRole, ModelStore, Prepared, CHUNK, NUM_MACROS};
+use nice_plug::prelude::*;
+use ressort_engine::ScaleClass;
+use std::num::NonZeroU32;
+use std::sync::atomic::Ordering;
+use std::sync::Arc;
+
+pub mod dsp;
+pub mod host;
+pub mod model;
+pub mod params;
+pub mod presets;
+pub mod runtime;
+
+use dsp::{db_to_gain, soft_ceiling, tuning_gain, ChunkSmoother, DcBlocker};
+use host::InputSource;
+use params::RessortParams;
+use runtime::RuntimeStatus;
+
+/// Length of the crossfade from a replaced model to the new one.
+const SWAP_FADE_MS: f64 = 20.0;
+/// Time for the output to fade back in after the guard reset an exploding model.
+const GUARD_FADE_MS: f64 = 50.0;
+/// A post-gain output above this (+24 dBFS) counts as an explosion even before the engine's
+/// own guard sees it.
+const BLAST_LEVEL: f64 = 16.0;
+/// Output and input below this count as silence for the host's sleep decision (−120 dBFS).
+const QUIET_LEVEL: f64 = 1e-6;
+/// Smoothing time constant of the physical controls.
+const CONTROL_SMOOTHING_MS: f64 = 15.0;
+/// Smoothing time constant of the gains.
+const GAIN_SMOOTHING_MS: f64 = 5.0;
+/// The Stiffness gain that Damping can never take away through the stability clamp: the
+/// model's own stiffness.
+const KEPT_STIFFNESS_GAIN: f64 = 1.0;
+
+/// What the plugin asks its background thread to do.
+#[derive(Debug, Clone, Copy)]
+pub enum Task {
+    /// Tell the host's log that the guard reset an exploding model.
+    ReportGuard { trips: u32 },
+}
+
+pub struct Ressort {
+    params: Arc<RessortParams>,
+    store: Arc<ModelStore>,
+    sample_rate: f64,
+    has_main_input: bool,
+    current: Option<Box<Prepared>>,
+    /// The model being faded out, and the samples left of the fade.
+    outgoing: Option<Box<Prepared>>,
+    fade_left: usize,
+    fade_len: usize,
+    /// Models waiting to go back to the store when its return channel was full.
+    held: [Option<Box<Prepared>>; 2],
+    stiffness: ChunkSmoother,
+    damping: ChunkSmoother,
+    tune: ChunkSmoother,
+    force_gain: ChunkSmoother,
+    position_gain: ChunkSmoother,
+    output_gain: ChunkSmoother,
+    macros: [ChunkSmoother; NUM_MACROS],
+    /// Output gain at the end of the previous chunk: the per-sample ramp starts there.
+    last_output_gain: f64,
+    dc: [DcBlocker; 2],
+    /// Fade-in after a guard reset: current gain and step per sample.
+    guard_gain: f64,
+    guard_step: f64,
+    /// Semitones from the reference key of the last note, and the pitch bend.
+    note_semitones: f64,
+    bend_semitones: f64,
+    pending_event: Option<NoteEvent<()>>,
+    /// Samples since activation: chunk boundaries are multiples of CHUNK.
+    counter: u64,
+    quiet_samples: u64,
+    host_in: [[f64; CHUNK]; 4],
+}
+
+impl Default for Ressort {
+    fn default() -> Self {
+        let store = Arc::new(ModelStore::default());
+        let params = Arc::new(RessortParams::new(store.clone()));
+        Ressort {
+            params,
+            store,
+            sample_rate: 48_000.0,
+            has_main_input: false,
+            current: None,
+            outgoing: None,
+            fade_left: 0,
+            fade_len: 1,
+            held: [None, None],
+            stiffness: ChunkSmoother::default(),
+            damping: ChunkSmoother::default(),
+            tune: ChunkSmoother::default(),
+            force_gain: ChunkSmoother::default(),
+            position_gain: ChunkSmoother::default(),
+            output_gain: ChunkSmoother::default(),
+            macros: [ChunkSmoother::default(); NUM_MACROS],
+            last_output_gain: 0.0,
+            dc: [DcBlocker::default(); 2],
+            guard_gain: 1.0,
+            guard_step: 0.0,
+            note_semitones: 0.0,
+            bend_semitones: 0.0,
+            pending_event: None,
+            counter: 0,
+            quiet_samples: 0,
+            host_in: [[0.0; CHUNK]; 4],
+        }
+    }
+}
+
+impl Ressort {
+    /// The model store shared with the editor.
+    pub fn store(&self) -> &Arc<ModelStore> {
+        &self.store
+    }
+
+    fn runtime(&self) -> &RuntimeStatus {
+        &self.store.runtime
+    }
+
+    /// Puts every smoother on its target and clears the filters: a fresh start.
+    fn snap_controls(&mut self) {
+        let sr = self.sample_rate;
+        let p = &self.params;
+        self.stiffness =
+            ChunkSmoother::new(sr, CHUNK, CONTROL_SMOOTHING_MS, p.stiffness.value() as f64);
+        self.damping =
+            ChunkSmoother::new(sr, CHUNK, CONTROL_SMOOTHING_MS, p.damping.value() as f64);
+        self.tune = ChunkSmoother::new(sr, CHUNK, CONTROL_SMOOTHING_MS, p.tune.value() as f64);
+        self.force_gain = ChunkSmoother::new(
+            sr,
+            CHUNK,
+            GAIN_SMOOTHING_MS,
+            db_to_gain(p.force_gain.value() as f64),
+        );
+        self.position_gain = ChunkSmoother::new(
+            sr,
+            CHUNK,
+            GAIN_SMOOTHING_MS,
+            db_to_gain(p.position_gain.value() as f64),
+        );
+        self.output_gain = ChunkSmoother::new(
+            sr,
+            CHUNK,
+            GAIN_SMOOTHING_MS,
+            db_to_gain(p.output_gain.value() as f64),
+        );
+        self.last_output_gain = self.output_gain.value;
+        for (s, m) in self.macros.iter_mut().zip(&p.macros) {
+            *s = ChunkSmoother::new(sr, CHUNK, CONTROL_SMOOTHING_MS, m.value.value() as f64);
+        }
+        self.dc = [DcBlocker::new(sr); 2];
+        self.guard_gain = 1.0;
+        self.guard_step = 0.0;
+        self.counter = 0;
+        self.quiet_samples = 0;
+        self.pending_event = None;
+    }
+
+    /// Returns a model to the store, or keeps it for a later try. Realtime-safe.
+    fn recycle(&mut self, prepared: Box<Prepared>) {
+        if let Err(back) = self.store.recycle(prepared) {
+            if let Some(slot) = self.held.iter_mut().find(|s| s.is_none()) {
+                *slot = Some(back);
+            } else {
+                // Both holding slots are taken and the return channel is full: keep the model
+                // alive rather than free it here.
+                std::mem::forget(back);
+            }
+        }
+    }
+
+    /// Picks up a new model from the store and starts the crossfade. Realtime-safe.
+    fn receive_models(&mut self) {
+        for i in 0..self.held.len() {
+            if let Some(p) = self.held[i].take() {
+                if let Err(back) = self.store.recycle(p) {
+                    self.held[i] = Some(back);
+                }
+            }
+        }
+        let Some(new) = self.store.receive() else {
+            return;
+        };
+        if new.sample_rate != self.sample_rate {
+            self.recycle(new);
+            return;
+        }
+        if let Some(old) = self.outgoing.take() {
+            self.recycle(old);
+        }
+        self.outgoing = self.current.replace(new);
+        self.fade_len = ((SWAP_FADE_MS * 1e-3 * self.sample_rate) as usize).max(1);
+        self.fade_left = if self.outgoing.is_some() {
+            self.fade_len
+        } else {
+            0
+        };
+        self.runtime()
+            .running_generation
+            .fetch_add(1, Ordering::AcqRel);
+        // The new model's gains and macros are set before its first sample.
+        self.apply_controls(false);
+    }
+
+    /// Advances the control smoothers (when `advance`) and applies the gains and macros to
+    /// the running model, clamped by its stability envelope.
+    fn apply_controls(&mut self, advance: bool) {
+        let p = &self.params;
+        let (st, dz, tune) = if advance {
+            (
+                self.stiffness.next(p.stiffness.value() as f64),
+                self.damping.next(p.damping.value() as f64),
+                self.tune.next(p.tune.value() as f64 + self.bend_semitones),
+            )
+        } else {
+            (self.stiffness.value, self.damping.value, self.tune.value)
+        };
+        if advance {
+            self.force_gain
+                .next(db_to_gain(p.force_gain.value() as f64));
+            self.position_gain
+                .next(db_to_gain(p.position_gain.value() as f64));
+            self.output_gain
+                .next(db_to_gain(p.output_gain.value() as f64));
+            for (s, m) in self.macros.iter_mut().zip(&p.macros) {
+                s.next(m.value.value() as f64);
+            }
+        }
+        let Some(model) = self.current.as_mut() else {
+            return;
+        };
+        let semitones = tune + self.note_semitones;
+        let tuning = tuning_gain(
+            semitones,
+            model.settings.reference_pitch_hz,
+            self.sample_rate,
+        );
+        let requested_k = 2f64.powf(st) * tuning;
+        let requested_z = 2f64.powf(dz);
+        let (gk, gz, clamped) = model
+            .envelope
+            .clamp(requested_k, requested_z, KEPT_STIFFNESS_GAIN);
+        model.engine.set_class_gain(ScaleClass::Stiffness, gk);
+        model.engine.set_class_gain(ScaleClass::Damping, gz);
+        for (slot, binding) in model.macros.iter().enumerate() {
+            if let Some(b) = binding {
+                let _ = model
+                    .engine
+                    .set_param(b.param, b.value_at(self.macros[slot].value));
+            }
+        }
+        let rt = &self.store.runtime;
+        rt.stiffness_gain.store(gk, Ordering::Relaxed);
+        rt.damping_gain.store(gz, Ordering::Relaxed);
+        rt.requested_stiffness_gain
+            .store(requested_k, Ordering::Relaxed);
+        rt.clamped.store(clamped, Ordering::Relaxed);
+    }
+
+    /// Handles the note events that fall before `end` (samples from the buffer start): note
+    /// impulses go into the model's note input at their exact sample. Returns true when the
+    /// pitch changed.
+    fn handle_events(
+        &mut self,
+        context: &mut impl ProcessContext<Self>,
+        start: usize,
+        len: usize,
+    ) -> bool {
+        let mut retuned = false;
+        loop {
+            let event = match self.pending_event.take() {
+                Some(e) => e,
+                None => match context.next_event() {
+                    Some(e) => e,
+                    None => break,
+                },
+            };
+            let timing = event.timing() as usize;
+            if timing >= start + len {
+                self.pending_event = Some(event);
+                break;
+            }
+            let frame = timing.saturating_sub(start).min(len - 1);
+            match event {
+                NoteEvent::NoteOn { key, velocity, .. } => {
+                    let Some(note) = key.number() else {
+                        continue;
+                    };
+                    let Some(model) = self.current.as_mut() else {
+                        continue;
+                    };
+                    self.note_semitones = note as f64 - model.settings.reference_key;
+                    retuned = true;
+                    if let Some(k) = model.note_input {
+                        let force = model.settings.note_force
+                            * velocity.clamp(0.0, 1.0) as f64
+                            * self.force_gain.value;
+                        model.inputs[k * len + frame] += force;
+                    }
+                }
+                NoteEvent::MidiPitchBend { value, .. } => {
+                    let v = if value.is_finite() {
+                        value.clamp(0.0, 1.0)
+                    } else {
+                        0.5
+                    };
+                    self.bend_semitones = (v as f64 - 0.5) * 4.0;
+                }
+                _ => {}
+            }
+        }
+        retuned
+    }
+
+    /// Fills a model's planar input scratch for one chunk from the host channels.
+    fn fill_inputs(
+        model: &mut Prepared,
+        host_in: &[[f64; CHUNK]; 4],
+        order: &[InputSource],
+        len: usize,
+        force: f64,
+        position: f64,
+    ) {
+        for (k, role) in model.roles.iter().enumerate() {
+            let source = model.routing[k].or_else(|| order.get(k).copied());
+            let gain = match role {
+                InputRole::Force => force,
+                InputRole::Position => position,
+                InputRole::AudioParam => 1.0,
+                InputRole::Unused => 0.0,
+            };
+            let dst = &mut model.inputs[k * len..(k + 1) * len];
+            match source.and_then(InputSource::channel) {
+                Some(c) if gain != 0.0 => {
+                    for (d, s) in dst.iter_mut().zip(&host_in[c][..len]) {
+                        *d = s * gain;
+                    }
+                }
+                _ => dst.fill(0.0),
+            }
+        }
+    }
+
+    /// The guard reset the model: count it, tell the host, fade back in.
+    fn guard_tripped(&mut self, context: &mut impl ProcessContext<Self>) {
+        if let Some(model) = self.current.as_mut() {
+            model.engine.reset();
+        }
+        self.dc.iter_mut().for_each(DcBlocker::reset);
+        self.guard_gain = 0.0;
+        self.guard_step = 1.0 / (GUARD_FADE_MS * 1e-3 * self.sample_rate).max(1.0);
+        let trips = self
+            .store
+            .runtime
+            .guard_trips
+            .fetch_add(1, Ordering::AcqRel)
+            + 1;
+        self.store
+            .runtime
+            .guard_active
+            .store(true, Ordering::Release);
+        context.execute_background(Task::ReportGuard { trips });
+    }
+}
+
+impl Plugin for Ressort {
+    const NAME: &'static str = "Ressort";
+    const VENDOR: &'static str = "Ressort";
+    const URL: &'static str = "https://ressort.audio";
+    const EMAIL: &'static str = "info@ressort.audio";
+    const VERSION: &'static str = env!("CARGO_PKG_VERSION");
+
+    const AUDIO_IO_LAYOUTS: &'static [AudioIOLayout] = &[
+        // Instrument: stereo out, stereo sidechain in.
+        AudioIOLayout {
+            main_input_channels: None,
+            main_output_channels: NonZeroU32::new(2),
+            aux_input_ports: &[new_nonzero_u32(2)],
+            aux_output_ports: &[],
+            names: PortNames {
+                layout: Some("Instrument with sidechain"),
+                main_input: None,
+                main_output: Some("Output"),
+                aux_inputs: &["Sidechain"],
+                aux_outputs: &[],
+            },
+        },
+        // Effect: stereo in and out, stereo sidechain in.
+        AudioIOLayout {
+            main_input_channels: NonZeroU32::new(2),
+            main_output_channels: NonZeroU32::new(2),
+            aux_input_ports: &[new_nonzero_u32(2)],
+            aux_output_ports: &[],
+            names: PortNames {
+                layout: Some("Effect with sidechain"),
+                main_input: Some("Input"),
+                main_output: Some("Output"),
+                aux_inputs: &["Sidechain"],
+                aux_outputs: &[],
+            },
+        },
+    ];
+
+    const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
+    const SAMPLE_ACCURATE_AUTOMATION: bool = true;
+
+    type SysExMessage = ();
+    type BackgroundTask = Task;
+    type Editor = ();
+
+    fn params(&self) -> Arc<dyn Params> {
+        self.params.clone()
+    }
+
+    fn task_executor(&mut self) -> TaskExecutor<Self> {
+        Box::new(|task| match task {
+            Task::ReportGuard { trips } => nice_log!(
+                "Ressort: the model exploded and was reset (guard trip {trips}); lower Stiffness \
+                 or check the model's stability report"
+            ),
+        })
+    }
+
+    fn activate(
+        &mut self,
+        audio_io_layout: &AudioIOLayout,
+        buffer_config: &BufferConfig,
+        _context: &mut impl ActivateContext<Self>,
+    ) -> bool {
+        let sr = buffer_config.sample_rate as f64;
+        if !(sr.is_finite() && (1.0..=1e7).contains(&sr)) {
+            return false;
+        }
+        self.sample_rate = sr;
+        self.has_main_input = audio_io_layout.main_input_channels.is_some();
+        self.outgoing = None;
+        self.held = [None, None];
+        self.current = self.store.activate(sr);
+        if self.current.is_none() {
+            return false;
+        }
+        self.snap_controls();
+        self.apply_controls(false);
+        true
+    }
+
+    fn reset(&mut self) {
+        if let Some(model) = self.current.as_mut() {
+            model.engine.reset();
+        }
+        if let Some(old) = self.outgoing.take() {
+            self.recycle(old);
+        }
+        self.fade_left = 0;
+        self.note_semitones = 0.0;
+        self.bend_semitones = 0.0;
+        self.snap_controls();
+        self.apply_controls(false);
+    }
+
+    fn deactivate(&mut self) {
+        self.current = None;
+        self.outgoing = None;
+        self.held = [None, None];
+        self.store.deactivate();
+    }
+
+    fn process(
+        &mut self,
+        buffer: &mut Buffer,
+        aux: &mut AuxiliaryBuffers,
+        context: &mut impl ProcessContext<Self>,
+    ) -> ProcessStatus {
+        let started = std::time::Instant::now();
+        self.receive_models();
+        let frames = buffer.samples();
+        let order = InputSource::default_order(self.has_main_input);
+        let mut loudest: f64 = 0.0;
+        let mut pos = 0;
+        while pos < frames {
+            let phase = (self.counter % CHUNK as u64) as usize;
+            let len = (CHUNK - phase).min(frames - pos);
+
+            // Host channels for this chunk: main input (in place in `buffer`), sidechain.
+            for row in self.host_in.iter_mut() {
+                row[..len].fill(0.0);
+            }
+            if self.has_main_input {
+                for (c, ch) in buffer.as_slice_immutable().iter().take(2).enumerate() {
+                    for (d, s) in self.host_in[c][..len].iter_mut().zip(&ch[pos..pos + len]) {
+                        *d = if s.is_finite() { *s as f64 } else { 0.0 };
+                    }
+                }
+            }
+            if let Some(sc) = aux.inputs.first() {
+                for (c, ch) in sc.as_slice_immutable().iter().take(2).enumerate() {
+                    if ch.len() >= pos + len {
+                        for (d, s) in self.host_in[2 + c][..len]
+                            .iter_mut()
+                            .zip(&ch[pos..pos + len])
+                        {
+                            *d = if s.is_finite() { *s as f64 } else { 0.0 };
+                        }
+                    }
+                }
+            }
+            for row in &self.host_in {
+                for s in &row[..len] {
+                    loudest = loudest.max(s.abs());
+                }
+            }
+
+            if phase == 0 {
+                self.apply_controls(true);
+            }
+            let (force, position) = (self.force_gain.value, self.position_gain.value);
+            if let Some(model) = self.current.as_mut() {
+                Self::fill_inputs(model, &self.host_in, order, len, force, position);
+            }
+            if self.handle_events(context, pos, len) {
+                self.apply_controls(false);
+            }
+
+            let mut tripped = false;
+            if let Some(model) = self.current.as_mut() {
+                let n_in = model.roles.len();
+                let n_out = model.outputs.len() / CHUNK;
+                let report = model.engine.process(
+                    len,
+                    &model.inputs[..n_in * len],
+                    &mut model.outputs[..n_out * len],
+                );
+                tripped |= report.tripped;
+            }
+            if let Some(old) = self.outgoing.as_mut() {
+                let n_in = old.roles.len();
+                let n_out = old.outputs.len() / CHUNK;
+                old.inputs[..n_in * len].fill(0.0);
+                old.engine.process(
+                    len,
+                    &old.inputs[..n_in * len],
+                    &mut old.outputs[..n_out * len],
+                );
+            }
+
+            // Output stage.
+            let g0 = self.last_output_gain;
+            let g1 = self.output_gain.value;
+            self.last_output_gain = g1;
+            let dc_on = self.params.dc_filter.value();
+            let out = buffer.as_slice();
+            for i in 0..len {
+                let pick = |m: &Prepared| -> (f64, f64) {
+                    if m.num_outputs == 0 {
+                        return (0.0, 0.0);
+                    }
+                    let l = m.outputs[i];
+                    let r = if m.num_outputs >= 2 {
+                        m.outputs[len + i]
+                    } else {
+                        l
+                    };
+                    (l, r)
+                };
+                let (mut l, mut r) = self.current.as_deref().map(pick).unwrap_or((0.0, 0.0));
+                if self.fade_left > 0 {
+                    if let Some(old) = self.outgoing.as_deref() {
+                        let (ol, or) = pick(old);
+                        let t = self.fade_left as f64 / self.fade_len as f64;
+                        l = l * (1.0 - t) + ol * t;
+                        r = r * (1.0 - t) + or * t;
+                    }
+                    self.fade_left -= 1;
+                }
+                let g = g0 + (g1 - g0) * (i + 1) as f64 / len as f64;
+                l *= g;
+                r *= g;
+                if dc_on {
+                    l = self.dc[0].process(l);
+                    r = self.dc[1].process(r);
+                }
+                if !(l.abs() <= BLAST_LEVEL && r.abs() <= BLAST_LEVEL) {
+                    tripped = true;
+                    l = 0.0;
+                    r = 0.0;
+                }
+                if self.guard_gain < 1.0 {
+                    l *= self.guard_gain;
+                    r *= self.guard_gain;
+                    self.guard_gain = (self.guard_gain + self.guard_step).min(1.0);
+                }
+                let (l, r) = (soft_ceiling(l), soft_ceiling(r));
+                loudest = loudest.max(l.abs()).max(r.abs());
+                if let Some(ch) = out.get_mut(0) {
+                    ch[pos + i] = l as f32;
+                }
+                if let Some(ch) = out.get_mut(1) {
+                    ch[pos + i] = r as f32;
+                }
+                if tripped {
+                    // Silence the rest of this chunk; the guard fade starts at the next one.
+                    self.guard_gain = 0.0;
+                }
+            }
+            if self.fade_left == 0 {
+                if let Some(old) = self.outgoing.take() {
+                    self.recycle(old);
+                }
+            }
+            if tripped {
+                self.guard_tripped(context);
+            }
+            pos += len;
+            self.counter += len as u64;
+        }
+        let rt = &self.store.runtime;
+        let seconds = frames as f64 / self.sample_rate;
+        if seconds > 0.0 {
+            let load = started.elapsed().as_secs_f64() / seconds;
+            let old = rt.cpu_load.load(Ordering::Relaxed);
+            rt.cpu_load
+                .store(old + 0.1 * (load - old), Ordering::Relaxed);
+        }
+        if loudest > QUIET_LEVEL || self.fade_left > 0 {
+            self.quiet_samples = 0;
+        } else {
+            self.quiet_samples += frames as u64;
+        }
+        // Let the host sleep the plugin once input and output have been silent for a second.
+        if self.quiet_samples as f64 > self.sample_rate {
+            ProcessStatus::Normal
+        } else {
+            ProcessStatus::KeepAlive
+        }
+    }
+}
+
+impl ClapPlugin for Ressort {
+    const CLAP_ID: &'static str = "audio.ressort.ressort";
+    const CLAP_DESCRIPTION: Option<&'static str> =
+        Some("Mass-interaction physical modelling: masses, springs, contacts, plucks and bows");
+    const CLAP_MANUAL_URL: Option<&'static str> = None;
+    const CLAP_SUPPORT_URL: Option<&'static str> = None;
+    const CLAP_FEATURES: &'static [ClapFeature] = &[
+        ClapFeature::Instrument,
+        ClapFeature::Synthesizer,
+        ClapFeature::AudioEffect,
+        ClapFeature::Stereo,
+    ];
+}
+
+impl Vst3Plugin for Ressort {
+    const VST3_CLASS_ID: [u8; 16] = *b"RessortMassInter";
+    const VST3_SUBCATEGORIES: &'static [Vst3SubCategory] = &[
+        Vst3SubCategory::Instrument,
+        Vst3SubCategory::Synth,
+        Vst3SubCategory::Fx,
+    ];
+}
+
+nice_export_clap!(Ressort);
+nice_export_vst3!(Ressort);

@@ -1,0 +1,702 @@
+//! Models in the plugin: preparing a script off the audio thread, handing it over without
+//! locks, and keeping the running script in the plugin state.
+//!
+//! A script becomes a [`Prepared`] model on the thread that submits it (the host's main
+//! thread for a state load or activation, the editor for an edit): parse, compile, stability
+//! envelope, macro ranges and scratch buffers are all made there. The audio thread receives it
+//! through a bounded lock-free channel and sends the replaced model back through another one,
+//! so it never allocates or frees. A script with errors never replaces the running model; its
+//! diagnostics are kept in [`ModelStore::status`] for the editor.
+
+use crate::host::{HostSettings, InputSource};
+use crate::runtime::RuntimeStatus;
+use crossbeam_channel::{Receiver, Sender};
+use nice_plug::params::persist::PersistentField;
+use ressort_engine::{
+    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, ParamId, ScaleClass,
+    StabilityWarning,
+};
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// The engine runs in chunks of at most this many samples; gains and macros are updated at
+/// chunk boundaries (counted from activation, so results do not depend on the host's block
+/// size).
+pub const CHUNK: usize = 16;
+
+/// The number of generic macro slots.
+pub const NUM_MACROS: usize = 16;
+
+/// Stability budget kept free by the Stiffness/Damping clamp: the loads of every mass and
+/// uniform structure stay below this fraction of the limit.
+pub const STABILITY_HEADROOM: f64 = 0.95;
+
+/// The saved part of the model: the script of the running model and where it came from.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ModelState {
+    /// A preset id (`mesh-25x20`) or a file name or "Custom".
+    pub name: String,
+    /// The complete script.
+    pub script: String,
+}
+
+/// What a model input carries, which decides its gain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputRole {
+    /// A `frcInput`: × Force gain.
+    Force,
+    /// A `posInput`: × Position gain.
+    Position,
+    /// An `audioParam`: the raw channel.
+    AudioParam,
+    /// Declared by no element.
+    Unused,
+}
+
+/// A macro slot bound to one of the model's `param`s.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MacroBinding {
+    pub param: ParamId,
+    pub name: String,
+    /// The declared value: the slot's centre (normalized 0.5).
+    pub default: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+impl MacroBinding {
+    /// Maps a slot position in [0, 1] to the parameter value: min at 0, the declared value
+    /// at 0.5, max at 1; geometric between positive bounds, linear otherwise.
+    pub fn value_at(&self, normalized: f64) -> f64 {
+        let n = normalized.clamp(0.0, 1.0);
+        let (a, b, t) = if n <= 0.5 {
+            (self.min, self.default, n * 2.0)
+        } else {
+            (self.default, self.max, (n - 0.5) * 2.0)
+        };
+        if a > 0.0 && b > 0.0 {
+            a * (b / a).powf(t)
+        } else {
+            a + (b - a) * t
+        }
+    }
+}
+
+/// One line of the stability envelope: a mass or structure whose load is
+/// `k·gK + z·gZ` for Stiffness gain gK and Damping gain gZ (stable below 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoadLine {
+    pub k: f64,
+    pub z: f64,
+}
+
+/// The loads that can limit the host gains, reduced to the ones that can be the worst for
+/// some gain pair (a mass whose K and Z loads are both below another's never limits).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StabilityEnvelope {
+    pub lines: Vec<LoadLine>,
+}
+
+impl StabilityEnvelope {
+    /// The largest Stiffness gain that keeps every load below [`STABILITY_HEADROOM`] at
+    /// Damping gain `gz` (infinite when no load depends on K).
+    pub fn max_stiffness(&self, gz: f64) -> f64 {
+        let mut g = f64::INFINITY;
+        for l in &self.lines {
+            if l.k > 0.0 {
+                g = g.min(((STABILITY_HEADROOM - gz * l.z) / l.k).max(0.0));
+            }
+        }
+        g
+    }
+
+    /// The largest Damping gain that keeps every load below the headroom at Stiffness gain
+    /// `gk`.
+    pub fn max_damping(&self, gk: f64) -> f64 {
+        let mut g = f64::INFINITY;
+        for l in &self.lines {
+            if l.z > 0.0 {
+                g = g.min(((STABILITY_HEADROOM - gk * l.k) / l.z).max(0.0));
+            }
+        }
+        g
+    }
+
+    /// Clamps a requested (Stiffness, Damping) gain pair into the stable region. Damping may
+    /// use only the budget left by `min(gk, k_floor)` (so turning Damping up never takes the
+    /// model's own stiffness away), then Stiffness takes what remains. Returns the gains and
+    /// whether anything was clamped.
+    pub fn clamp(&self, gk: f64, gz: f64, k_floor: f64) -> (f64, f64, bool) {
+        let z = gz.min(self.max_damping(gk.min(k_floor)));
+        let k = gk.min(self.max_stiffness(z));
+        (k, z, k < gk || z < gz)
+    }
+
+    fn from_loads(mut loads: Vec<LoadLine>) -> StabilityEnvelope {
+        // Sort by K load, largest first; keep a line only if its Z load beats every line with a
+        // larger K load.
+        loads.sort_by(|a, b| b.k.total_cmp(&a.k).then(b.z.total_cmp(&a.z)));
+        let mut lines: Vec<LoadLine> = Vec::new();
+        let mut best_z = f64::NEG_INFINITY;
+        for l in loads {
+            if !(l.k.is_finite() && l.z.is_finite()) {
+                continue;
+            }
+            if l.z > best_z {
+                best_z = l.z;
+                lines.push(l);
+            }
+        }
+        StabilityEnvelope { lines }
+    }
+}
+
+/// A model ready to run: compiled for one sample rate, with its scratch buffers.
+#[derive(Debug)]
+pub struct Prepared {
+    pub engine: Engine,
+    pub sample_rate: f64,
+    pub name: String,
+    pub settings: HostSettings,
+    /// Planar input scratch, `roles.len()` channels of [`CHUNK`] samples.
+    pub inputs: Vec<f64>,
+    /// Planar output scratch, `max(outputs, 1)` channels of [`CHUNK`] samples.
+    pub outputs: Vec<f64>,
+    pub num_outputs: usize,
+    /// One entry per model input channel (`@in1` first).
+    pub roles: Vec<InputRole>,
+    /// The host channel feeding each model input, when the script chose one.
+    pub routing: Vec<Option<InputSource>>,
+    /// The model input a MIDI note strikes (0-based), if it exists.
+    pub note_input: Option<usize>,
+    pub macros: Vec<Option<MacroBinding>>,
+    pub envelope: StabilityEnvelope,
+    /// Loads at unit gains: (worst load, label of the worst mass or structure).
+    pub worst_load: (f64, String),
+}
+
+/// A model's description for the editor and the tests: counts and analysis, made when it
+/// was prepared.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ModelSummary {
+    pub name: String,
+    pub points: usize,
+    pub interactions: usize,
+    pub inputs: Vec<String>,
+    pub outputs: Vec<String>,
+    pub params: Vec<String>,
+    pub macros: Vec<Option<MacroBinding>>,
+    pub stability: Vec<String>,
+    pub reference_pitch_hz: Option<f64>,
+    pub reference_key: f64,
+}
+
+/// The result of a script submission.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ModelStatus {
+    /// The running model.
+    pub summary: ModelSummary,
+    /// Diagnostics of the last submitted script (`LINE:COL: error: …`), empty when it loaded.
+    pub diagnostics: Vec<String>,
+    /// The last script that failed, kept for the editor.
+    pub rejected: Option<ModelState>,
+}
+
+/// Why a script did not become the running model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rejected(pub Vec<String>);
+
+impl std::fmt::Display for Rejected {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0.join("\n"))
+    }
+}
+
+/// Parses a script and turns every error into a `LINE:COL: error: …` line. Warnings are kept
+/// too, after the errors, when the script is accepted.
+pub fn parse_script(text: &str) -> Result<(ModelSpec, HostSettings, Vec<String>), Rejected> {
+    let parsed = parse(text);
+    let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
+    if !errors.is_empty() {
+        return Err(Rejected(errors));
+    }
+    let warnings: Vec<String> = parsed.diagnostics.iter().map(|d| d.to_string()).collect();
+    let Some(spec) = parsed.spec else {
+        return Err(Rejected(vec![
+            "1:1: error: the script describes no model".into()
+        ]));
+    };
+    let settings = HostSettings::from_spec(&spec).map_err(Rejected)?;
+    Ok((spec, settings, warnings))
+}
+
+/// Compiles a script for a sample rate and derives everything the audio thread needs.
+pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rejected> {
+    let (spec, settings, _warnings) = parse_script(text)?;
+    let mut engine = compile(&spec, &CompileOptions::at(sample_rate))
+        .map_err(|e| Rejected(e.0.iter().map(|e| format!("1:1: error: {e}")).collect()))?;
+    let info = engine.info().clone();
+
+    let roles: Vec<InputRole> = info
+        .inputs
+        .iter()
+        .map(|uses| match uses.first() {
+            Some(InputUse::Force(_)) => InputRole::Force,
+            Some(InputUse::Position(_)) => InputRole::Position,
+            Some(InputUse::Param(_)) => InputRole::AudioParam,
+            None => InputRole::Unused,
+        })
+        .collect();
+    let routing = (0..roles.len())
+        .map(|i| settings.routing.get(i).copied().flatten())
+        .collect();
+    let note_input = settings
+        .note_input
+        .map(|i| i as usize)
+        .filter(|&i| roles.get(i) == Some(&InputRole::Force))
+        .or_else(|| roles.iter().position(|r| *r == InputRole::Force));
+
+    let envelope = envelope(&mut engine);
+    let report = engine.stability();
+    let worst_load = worst_load(&report);
+    let macros = macro_bindings(&mut engine, &settings);
+
+    let num_outputs = info.num_outputs();
+    Ok(Prepared {
+        inputs: vec![0.0; roles.len() * CHUNK],
+        outputs: vec![0.0; num_outputs.max(1) * CHUNK],
+        num_outputs,
+        roles,
+        routing,
+        note_input,
+        macros,
+        envelope,
+        worst_load,
+        settings,
+        sample_rate,
+        name: name.to_string(),
+        engine,
+    })
+}
+
+fn worst_load(report: &ressort_engine::StabilityReport) -> (f64, String) {
+    let mut worst = report
+        .worst()
+        .map(|m| (m.load(), m.label.clone()))
+        .unwrap_or((0.0, String::new()));
+    for w in &report.warnings {
+        if let StabilityWarning::StructureLimit { label, load, .. } = w {
+            if *load > worst.0 {
+                worst = (*load, label.clone());
+            }
+        }
+    }
+    worst
+}
+
+/// Splits every stability load into its Stiffness and Damping parts by analysing the model
+/// with one class switched off at a time.
+fn envelope(engine: &mut Engine) -> StabilityEnvelope {
+    engine.set_class_gain(ScaleClass::Damping, 0.0);
+    let k_only = engine.stability();
+    engine.set_class_gain(ScaleClass::Damping, 1.0);
+    engine.set_class_gain(ScaleClass::Stiffness, 0.0);
+    let z_only = engine.stability();
+    engine.set_class_gain(ScaleClass::Stiffness, 1.0);
+    engine.apply_pending_changes();
+
+    let mut loads: Vec<LoadLine> = k_only
+        .masses
+        .iter()
+        .zip(&z_only.masses)
+        .map(|(k, z)| LoadLine {
+            k: k.load(),
+            z: z.load(),
+        })
+        .collect();
+    loads.extend(structure_loads(engine));
+    StabilityEnvelope::from_loads(loads)
+}
+
+/// The uniform-structure loads (λ_K + 2λ_Z)/4M split into K and Z parts. The analysis reports
+/// a structure only above its limit, so it is run with the gains raised until every structure
+/// shows, then scaled back.
+fn structure_loads(engine: &mut Engine) -> Vec<LoadLine> {
+    const PROBE: f64 = 1e6;
+    let collect = |engine: &mut Engine| -> Vec<(String, f64)> {
+        engine
+            .stability()
+            .warnings
+            .into_iter()
+            .filter_map(|w| match w {
+                StabilityWarning::StructureLimit { label, load, .. } => Some((label, load)),
+                _ => None,
+            })
+            .collect()
+    };
+    engine.set_class_gain(ScaleClass::Stiffness, PROBE);
+    engine.set_class_gain(ScaleClass::Damping, 0.0);
+    let k = collect(engine);
+    engine.set_class_gain(ScaleClass::Stiffness, 0.0);
+    engine.set_class_gain(ScaleClass::Damping, PROBE);
+    let z = collect(engine);
+    engine.set_class_gain(ScaleClass::Stiffness, 1.0);
+    engine.set_class_gain(ScaleClass::Damping, 1.0);
+    engine.apply_pending_changes();
+    let mut lines = Vec::new();
+    for (label, kl) in &k {
+        let zl = z
+            .iter()
+            .find(|(l, _)| l == label)
+            .map(|(_, v)| *v)
+            .unwrap_or(0.0);
+        lines.push(LoadLine {
+            k: kl / PROBE,
+            z: zl / PROBE,
+        });
+    }
+    for (label, zl) in &z {
+        if !k.iter().any(|(l, _)| l == label) {
+            lines.push(LoadLine {
+                k: 0.0,
+                z: zl / PROBE,
+            });
+        }
+    }
+    lines
+}
+
+/// Binds the macro slots to the model's control-rate `param`s in declaration order, with the
+/// script's ranges or a default range around the declared value that the stability analysis
+/// accepts.
+fn macro_bindings(engine: &mut Engine, settings: &HostSettings) -> Vec<Option<MacroBinding>> {
+    let params: Vec<(usize, String, f64)> = engine
+        .info()
+        .params
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.audio_input.is_none())
+        .map(|(i, p)| (i, p.name.clone(), p.default))
+        .collect();
+    let mut out: Vec<Option<MacroBinding>> = vec![None; NUM_MACROS];
+    let base_stable = engine.stability().is_stable();
+    for (slot, (index, name, default)) in params.into_iter().take(NUM_MACROS).enumerate() {
+        let id = ParamId(index as u32);
+        let declared = settings.macro_ranges.iter().find(|r| r.name == name);
+        let (min, max) = match declared {
+            Some(r) => (r.min, r.max),
+            None => {
+                let (lo, hi) = default_range(default);
+                let hi = if base_stable {
+                    stable_towards(engine, id, default, hi)
+                } else {
+                    hi
+                };
+                let lo = if base_stable {
+                    stable_towards(engine, id, default, lo)
+                } else {
+                    lo
+                };
+                (lo, hi)
+            }
+        };
+        let _ = engine.set_param(id, default);
+        out[slot] = Some(MacroBinding {
+            param: id,
+            name,
+            default: default.clamp(min.min(max), max.max(min)),
+            min,
+            max,
+        });
+    }
+    engine.apply_pending_changes();
+    out
+}
+
+/// ×1/4 … ×4 around a non-zero value; 0 … 1 around zero.
+fn default_range(v: f64) -> (f64, f64) {
+    if v > 0.0 {
+        (v / 4.0, v * 4.0)
+    } else if v < 0.0 {
+        (v * 4.0, v / 4.0)
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+/// The value closest to `target` on the segment from `from` (stable) that keeps the model
+/// stable, found by bisection.
+fn stable_towards(engine: &mut Engine, id: ParamId, from: f64, target: f64) -> f64 {
+    let stable_at = |engine: &mut Engine, v: f64| {
+        engine.set_param(id, v).is_ok() && {
+            let r = engine.stability();
+            r.is_stable() && worst_load(&r).0 < STABILITY_HEADROOM
+        }
+    };
+    if stable_at(engine, target) {
+        return target;
+    }
+    let (mut good, mut bad) = (from, target);
+    for _ in 0..24 {
+        let mid = 0.5 * (good + bad);
+        if stable_at(engine, mid) {
+            good = mid;
+        } else {
+            bad = mid;
+        }
+    }
+    good
+}
+
+impl Prepared {
+    /// The editor's description of this model.
+    pub fn summary(&mut self) -> ModelSummary {
+        let info = self.engine.info();
+        let inputs = info
+            .inputs
+            .iter()
+            .enumerate()
+            .map(|(i, uses)| {
+                let what: Vec<String> = uses
+                    .iter()
+                    .map(|u| match u {
+                        InputUse::Force(t) => format!("force on @{t}"),
+                        InputUse::Position(t) => format!("position of @{t}"),
+                        InputUse::Param(t) => format!("audio parameter {t}"),
+                    })
+                    .collect();
+                format!("in{}: {}", i + 1, what.join(", "))
+            })
+            .collect();
+        let outputs = info
+            .outputs
+            .iter()
+            .enumerate()
+            .map(|(i, o)| match o {
+                ressort_engine::OutputUse::Position(t) => format!("out{}: position of @{t}", i + 1),
+                ressort_engine::OutputUse::Force(t) => format!("out{}: force on @{t}", i + 1),
+                ressort_engine::OutputUse::Unused => format!("out{}: unused", i + 1),
+            })
+            .collect();
+        let params = info.params.iter().map(|p| p.name.clone()).collect();
+        let (points, interactions) = (info.num_points, info.num_interactions);
+        let report = self.engine.stability();
+        let mut stability: Vec<String> = report.warnings.iter().map(|w| w.to_string()).collect();
+        if let Some(w) = report.worst() {
+            stability.insert(
+                0,
+                format!(
+                    "closest to the limit: @{} ({:.1} % of 4M used)",
+                    w.label,
+                    100.0 * w.load()
+                ),
+            );
+        }
+        ModelSummary {
+            name: self.name.clone(),
+            points,
+            interactions,
+            inputs,
+            outputs,
+            params,
+            macros: self.macros.clone(),
+            stability,
+            reference_pitch_hz: self.settings.reference_pitch_hz,
+            reference_key: self.settings.reference_key,
+        }
+    }
+}
+
+/// Four significant digits, without exponent for ordinary magnitudes.
+pub fn format_value(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        format!("{v:.3e}")
+    } else {
+        let digits = if a >= 1.0 {
+            3 - a.log10().floor() as i32
+        } else {
+            4
+        };
+        format!("{v:.*}", digits.clamp(0, 6) as usize)
+    }
+}
+
+/// The model shared by the plugin, its parameters (as a persistent field) and the editor.
+#[derive(Debug)]
+pub struct ModelStore {
+    /// The running model's script: what the plugin state saves.
+    running: Mutex<ModelState>,
+    status: Mutex<ModelStatus>,
+    /// Sample rate of the active plugin (f64 bits), 0 while inactive.
+    sample_rate: AtomicU64,
+    /// Bumped for every model sent to the audio thread.
+    generation: AtomicU64,
+    to_audio: (Sender<Box<Prepared>>, Receiver<Box<Prepared>>),
+    garbage: (Sender<Box<Prepared>>, Receiver<Box<Prepared>>),
+    /// What the audio thread reports.
+    pub runtime: RuntimeStatus,
+}
+
+impl Default for ModelStore {
+    fn default() -> Self {
+        let preset = crate::presets::Preset::default_preset();
+        ModelStore {
+            running: Mutex::new(ModelState {
+                name: preset.id.to_string(),
+                script: preset.text.to_string(),
+            }),
+            status: Mutex::new(ModelStatus::default()),
+            sample_rate: AtomicU64::new(0),
+            generation: AtomicU64::new(0),
+            to_audio: crossbeam_channel::bounded(4),
+            garbage: crossbeam_channel::bounded(64),
+            runtime: RuntimeStatus::default(),
+        }
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+impl ModelStore {
+    /// The running model's name and script.
+    pub fn running(&self) -> ModelState {
+        lock(&self.running).clone()
+    }
+
+    /// The running model's summary and the last submission's diagnostics.
+    pub fn status(&self) -> ModelStatus {
+        lock(&self.status).clone()
+    }
+
+    /// The value text of macro slot `slot` at position `normalized`: `K = 0.1200`, or
+    /// `unbound` when the model has fewer parameters.
+    pub fn macro_text(&self, slot: usize, normalized: f64) -> String {
+        let status = lock(&self.status);
+        match status.summary.macros.get(slot) {
+            Some(Some(b)) => format!("{} = {}", b.name, format_value(b.value_at(normalized))),
+            _ => format!("unbound ({:.0} %)", normalized * 100.0),
+        }
+    }
+
+    /// How many models have been sent to the audio thread.
+    pub fn generation(&self) -> u64 {
+        self.generation.load(Ordering::Acquire)
+    }
+
+    /// Frees models the audio thread has finished with.
+    pub fn collect_garbage(&self) {
+        while self.garbage.1.try_recv().is_ok() {}
+    }
+
+    /// Sets the running script from outside the audio thread: a state load, the editor, a
+    /// preset. While the plugin is active the model is compiled now and handed to the audio
+    /// thread, which crossfades to it; while inactive it is only checked, and
+    /// [`ModelStore::activate`] compiles it. A script with errors changes nothing but the
+    /// diagnostics.
+    pub fn submit(&self, state: ModelState) -> Result<(), Rejected> {
+        self.collect_garbage();
+        let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
+        let result = if rate > 0.0 {
+            prepare(&state.name, &state.script, rate).map(Some)
+        } else {
+            parse_script(&state.script).map(|_| None)
+        };
+        match result {
+            Ok(prepared) => {
+                let mut status = lock(&self.status);
+                status.diagnostics.clear();
+                status.rejected = None;
+                if let Some(mut p) = prepared {
+                    status.summary = p.summary();
+                    drop(status);
+                    self.send(Box::new(p));
+                }
+                *lock(&self.running) = state;
+                Ok(())
+            }
+            Err(rejected) => {
+                let mut status = lock(&self.status);
+                status.diagnostics = rejected.0.clone();
+                status.rejected = Some(state);
+                Err(rejected)
+            }
+        }
+    }
+
+    fn send(&self, prepared: Box<Prepared>) {
+        // Models still waiting are stale now; drop them here, not on the audio thread.
+        while self.to_audio.1.try_recv().is_ok() {}
+        if self.to_audio.0.try_send(prepared).is_ok() {
+            self.generation.fetch_add(1, Ordering::AcqRel);
+        }
+    }
+
+    /// Compiles the running script for `sample_rate` at activation. When it cannot be
+    /// compiled at this rate, the default preset runs instead and the diagnostics say why.
+    pub fn activate(&self, sample_rate: f64) -> Option<Box<Prepared>> {
+        self.collect_garbage();
+        while self.to_audio.1.try_recv().is_ok() {}
+        self.sample_rate
+            .store(sample_rate.to_bits(), Ordering::Release);
+        let state = self.running();
+        let mut prepared = match prepare(&state.name, &state.script, sample_rate) {
+            Ok(p) => p,
+            Err(rejected) => {
+                let preset = crate::presets::Preset::default_preset();
+                let fallback = prepare(preset.id, preset.text, sample_rate).ok()?;
+                let mut status = lock(&self.status);
+                status.diagnostics = rejected.0;
+                status.rejected = Some(state);
+                drop(status);
+                *lock(&self.running) = ModelState {
+                    name: preset.id.to_string(),
+                    script: preset.text.to_string(),
+                };
+                fallback
+            }
+        };
+        lock(&self.status).summary = prepared.summary();
+        Some(Box::new(prepared))
+    }
+
+    /// Marks the plugin inactive and frees what the audio thread returned.
+    pub fn deactivate(&self) {
+        self.sample_rate.store(0, Ordering::Release);
+        while self.to_audio.1.try_recv().is_ok() {}
+        self.collect_garbage();
+    }
+
+    /// Audio thread: the newest model waiting, if any. Realtime-safe.
+    pub fn receive(&self) -> Option<Box<Prepared>> {
+        // One per call: an older model still queued arrives at the next block and is replaced
+        // at once, so nothing is ever dropped here.
+        self.to_audio.1.try_recv().ok()
+    }
+
+    /// Audio thread: hands a finished model back to be freed elsewhere. Returns it when the
+    /// return channel is full, so the caller keeps it until the next try. Realtime-safe.
+    pub fn recycle(&self, prepared: Box<Prepared>) -> Result<(), Box<Prepared>> {
+        self.garbage
+            .0
+            .try_send(prepared)
+            .map_err(|e| e.into_inner())
+    }
+}
+
+impl<'a> PersistentField<'a, ModelState> for Arc<ModelStore> {
+    fn set(&self, new_value: ModelState) {
+        // A state whose script does not load keeps the running model; the diagnostics say why.
+        let _ = self.submit(new_value);
+    }
+
+    fn map<F, R>(&self, f: F) -> R
+    where
+        F: Fn(&ModelState) -> R,
+    {
+        f(&lock(&self.running))
+    }
+}

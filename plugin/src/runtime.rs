@@ -1,0 +1,39 @@
+//! What the audio thread reports, as atomics that the editor and the tests read.
+
+use atomic_float::AtomicF64;
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64};
+
+/// Live state of the running plugin. Written by the audio thread without locks.
+#[derive(Debug)]
+pub struct RuntimeStatus {
+    /// How many times the guard reset an exploding model since the plugin was created.
+    pub guard_trips: AtomicU32,
+    /// Set on a guard trip; cleared by whoever shows it (the editor's reset button).
+    pub guard_active: AtomicBool,
+    /// The Stiffness and Damping gains in use, after the stability clamp.
+    pub stiffness_gain: AtomicF64,
+    pub damping_gain: AtomicF64,
+    /// The Stiffness gain asked for (Stiffness × Tune × MIDI pitch) before the clamp.
+    pub requested_stiffness_gain: AtomicF64,
+    /// True while the clamp holds a gain below what was asked for.
+    pub clamped: AtomicBool,
+    /// Processing time as a fraction of real time, smoothed.
+    pub cpu_load: AtomicF64,
+    /// How many models the audio thread has switched to.
+    pub running_generation: AtomicU64,
+}
+
+impl Default for RuntimeStatus {
+    fn default() -> Self {
+        RuntimeStatus {
+            guard_trips: AtomicU32::new(0),
+            guard_active: AtomicBool::new(false),
+            stiffness_gain: AtomicF64::new(1.0),
+            damping_gain: AtomicF64::new(1.0),
+            requested_stiffness_gain: AtomicF64::new(1.0),
+            clamped: AtomicBool::new(false),
+            cpu_load: AtomicF64::new(0.0),
+            running_generation: AtomicU64::new(0),
+        }
+    }
+}

@@ -1,0 +1,161 @@
+//! Model preparation in the plugin: every built-in preset compiles at the common rates, the
+//! stability clamp holds exploding gains back, macro slots bind and map, and a bad script
+//! never replaces the running model.
+
+use ressort_engine::ScaleClass;
+use ressort_plugin::model::{prepare, ModelState, ModelStore, CHUNK, STABILITY_HEADROOM};
+use ressort_plugin::presets::{Preset, PRESETS};
+
+#[test]
+fn every_preset_prepares_at_every_common_rate() {
+    for preset in PRESETS {
+        for sr in [44_100.0, 48_000.0, 96_000.0] {
+            let p = prepare(preset.id, preset.text, sr)
+                .unwrap_or_else(|e| panic!("{} at {sr}: {e}", preset.id));
+            assert_eq!(p.inputs.len(), p.roles.len() * CHUNK);
+            assert!(p.outputs.len() >= CHUNK);
+            assert!(
+                !p.envelope.lines.is_empty(),
+                "{}: no stability lines",
+                preset.id
+            );
+            assert!(
+                p.worst_load.0 < 1.0,
+                "{} is unstable at unit gains: {:?}",
+                preset.id,
+                p.worst_load
+            );
+            for key in ["What:", "How to play:", "Source:"] {
+                assert!(
+                    !preset.header_field(key).is_empty(),
+                    "{} lacks {key}",
+                    preset.id
+                );
+            }
+        }
+    }
+}
+
+/// The clamp's limit is where the analysis says the model stops being stable: at the limit
+/// every load is at the headroom, just above it the analysis reports an unstable model.
+#[test]
+fn the_stiffness_limit_matches_the_stability_analysis() {
+    for preset in PRESETS {
+        let mut p = prepare(preset.id, preset.text, 48_000.0).unwrap();
+        let limit = p.envelope.max_stiffness(1.0);
+        assert!(limit.is_finite() && limit > 0.0, "{}: {limit}", preset.id);
+        p.engine.set_class_gain(ScaleClass::Stiffness, limit);
+        let at = p.engine.stability();
+        assert!(at.is_stable(), "{} at its limit ×{limit}", preset.id);
+        let worst = at.worst().map(|m| m.load()).unwrap_or(0.0);
+        p.engine
+            .set_class_gain(ScaleClass::Stiffness, limit / STABILITY_HEADROOM * 1.05);
+        let over = p.engine.stability();
+        let structure_over = over
+            .warnings
+            .iter()
+            .any(|w| matches!(w, ressort_engine::StabilityWarning::StructureLimit { .. }));
+        assert!(
+            !over.is_stable() || structure_over,
+            "{}: ×{} past the limit still passes",
+            preset.id,
+            limit / STABILITY_HEADROOM * 1.05
+        );
+        println!(
+            "{:<20} stiffness limit ×{limit:8.3} (worst mass load there {:.3})",
+            preset.id, worst
+        );
+    }
+}
+
+/// Asking for ×16 stiffness and ×16 damping on every preset gives clamped gains under which
+/// the model runs for a second, struck, without the guard tripping.
+#[test]
+fn clamped_gains_keep_every_preset_running() {
+    for preset in PRESETS {
+        let mut p = prepare(preset.id, preset.text, 48_000.0).unwrap();
+        let (gk, gz, clamped) = p.envelope.clamp(16.0, 16.0, 1.0);
+        println!(
+            "{:<20} ×16/×16 requested → stiffness ×{gk:.3}, damping ×{gz:.3} (clamped {clamped})",
+            preset.id
+        );
+        p.engine.set_class_gain(ScaleClass::Stiffness, gk);
+        p.engine.set_class_gain(ScaleClass::Damping, gz);
+        let n_in = p.roles.len();
+        let n_out = p.outputs.len() / CHUNK;
+        let mut peak: f64 = 0.0;
+        for block in 0..(48_000 / CHUNK) {
+            p.inputs.fill(0.0);
+            if block == 0 {
+                if let Some(k) = p.note_input {
+                    p.inputs[k * CHUNK] = -0.05;
+                }
+            }
+            let report = p.engine.process(
+                CHUNK,
+                &p.inputs[..n_in * CHUNK],
+                &mut p.outputs[..n_out * CHUNK],
+            );
+            assert!(!report.tripped, "{} exploded at ×{gk}", preset.id);
+            peak = p.outputs.iter().fold(peak, |a, x| a.max(x.abs()));
+        }
+        assert!(peak.is_finite());
+    }
+}
+
+#[test]
+fn macro_slots_bind_params_in_declaration_order() {
+    let text = "@K param 0.1\n@Z param 0.001\n@m mass 1 0 0\n@g ground 0\n\
+                @s springDamper @m @g K Z\n@in1 frcInput @m\n@out1 posOutput @m\n";
+    let p = prepare("test", text, 48_000.0).unwrap();
+    let k = p.macros[0].as_ref().expect("slot 1 bound");
+    let z = p.macros[1].as_ref().expect("slot 2 bound");
+    assert!(p.macros[2..].iter().all(Option::is_none));
+    assert_eq!((k.name.as_str(), z.name.as_str()), ("K", "Z"));
+    // The declared value sits in the middle; the ends are the range.
+    assert!((k.value_at(0.5) - 0.1).abs() < 1e-12);
+    assert!((k.value_at(0.0) - k.min).abs() < 1e-12);
+    assert!((k.value_at(1.0) - k.max).abs() < 1e-12);
+    assert!(k.min < 0.1 && k.max > 0.1);
+    // ×4 of K = 0.4 at M = 1 is stable (0.4 + 0.002 < 4), so the full default range stays.
+    assert!((k.max - 0.4).abs() < 1e-9, "{}", k.max);
+    println!("K range {}..{}, Z range {}..{}", k.min, k.max, z.min, z.max);
+}
+
+#[test]
+fn macro_ranges_stop_where_the_model_would_explode() {
+    // K = 3 on M = 1: ×4 would be 12 > 4M, so the range stops below 4 (at the headroom).
+    let text = "@K param 3\n@m mass 1 0 0\n@g ground 0\n@s spring @m @g K\n\
+                @in1 frcInput @m\n@out1 posOutput @m\n";
+    let p = prepare("test", text, 44_100.0).unwrap();
+    let k = p.macros[0].as_ref().unwrap();
+    assert!(k.max < 4.0 && k.max > 3.0, "max {}", k.max);
+    println!("K = 3 on M = 1: macro range {}..{}", k.min, k.max);
+}
+
+#[test]
+fn a_bad_script_keeps_the_running_model_and_reports_where() {
+    let store = ModelStore::default();
+    let before = store.running();
+    let err = store
+        .submit(ModelState {
+            name: "broken".into(),
+            script: "@m mass 1 0 0\n@s spring @m @nowhere 0.1\n".into(),
+        })
+        .unwrap_err();
+    assert_eq!(store.running(), before);
+    let status = store.status();
+    assert_eq!(status.diagnostics, err.0);
+    assert!(err.0[0].starts_with("2:"), "{:?}", err.0);
+    assert_eq!(status.rejected.unwrap().name, "broken");
+
+    let good = Preset::find("string-1000").unwrap();
+    store
+        .submit(ModelState {
+            name: good.id.into(),
+            script: good.text.into(),
+        })
+        .unwrap();
+    assert_eq!(store.running().name, "string-1000");
+    assert!(store.status().diagnostics.is_empty());
+}
