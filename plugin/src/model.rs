@@ -257,6 +257,10 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
         .filter(|&i| roles.get(i) == Some(&InputRole::Force))
         .or_else(|| roles.iter().position(|r| *r == InputRole::Force));
 
+    let mut settings = settings;
+    if settings.reference_pitch_hz.is_none() {
+        settings.reference_pitch_hz = estimate_pitch(&mut engine, note_input, &roles);
+    }
     let envelope = envelope(&mut engine);
     let report = engine.stability();
     let worst_load = worst_load(&report);
@@ -278,6 +282,92 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
         name: name.to_string(),
         engine,
     })
+}
+
+/// Work budget of the pitch estimate, in element-steps: small models get a long window,
+/// models too large for it get none (the tuning law then uses its low-frequency limit).
+const PITCH_BUDGET: f64 = 4e7;
+/// Length of the pitch estimate's impulse response.
+const PITCH_WINDOW: usize = 8192;
+
+/// The model's reference pitch: the strongest spectral peak of `@out1` after a force impulse
+/// on the note input, found by rendering [`PITCH_WINDOW`] samples off the audio thread. The
+/// engine is reset afterwards. None when the model has no force input or output, is too large
+/// for the budget, or does not ring.
+fn estimate_pitch(
+    engine: &mut Engine,
+    note_input: Option<usize>,
+    roles: &[InputRole],
+) -> Option<f64> {
+    let k = note_input?;
+    let info = engine.info();
+    if info.num_outputs() == 0 {
+        return None;
+    }
+    let size = (info.num_points + info.num_interactions).max(1) as f64;
+    if size * PITCH_WINDOW as f64 > PITCH_BUDGET {
+        return None;
+    }
+    let sr = engine.sample_rate_hz();
+    let n_in = roles.len();
+    let n_out = info.num_outputs();
+    let mut inputs = vec![0.0; n_in * CHUNK];
+    let mut outputs = vec![0.0; n_out * CHUNK];
+    let mut signal = Vec::with_capacity(PITCH_WINDOW);
+    inputs[k * CHUNK] = -1e-3;
+    while signal.len() < PITCH_WINDOW {
+        engine.process(CHUNK, &inputs, &mut outputs);
+        inputs.fill(0.0);
+        signal.extend_from_slice(&outputs[..CHUNK]);
+    }
+    let tripped = engine.is_tripped();
+    engine.reset();
+    if tripped {
+        return None;
+    }
+    peak_frequency(&signal, sr)
+}
+
+/// The frequency of the strongest peak above 20 Hz (Hann window, parabolic interpolation of
+/// the log magnitude).
+pub fn peak_frequency(signal: &[f64], sample_rate: f64) -> Option<f64> {
+    let n = signal.len();
+    let mean = signal.iter().sum::<f64>() / n as f64;
+    let mut frame: Vec<f64> = signal
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos();
+            (x - mean) * w
+        })
+        .collect();
+    let fft = realfft::RealFftPlanner::<f64>::new().plan_fft_forward(n);
+    let mut spectrum = fft.make_output_vec();
+    fft.process(&mut frame, &mut spectrum).ok()?;
+    let mags: Vec<f64> = spectrum.iter().map(|c| c.norm()).collect();
+    let lo = ((20.0 * n as f64 / sample_rate).ceil() as usize).max(1);
+    let (mut best, mut best_mag) = (0, 0.0);
+    for (i, &m) in mags.iter().enumerate().take(mags.len() - 1).skip(lo) {
+        if m > best_mag {
+            best = i;
+            best_mag = m;
+        }
+    }
+    if !(best_mag > 0.0 && best_mag.is_finite()) {
+        return None;
+    }
+    let (a, b, c) = (
+        mags[best - 1].max(1e-300).ln(),
+        best_mag.ln(),
+        mags[best + 1].max(1e-300).ln(),
+    );
+    let denom = a - 2.0 * b + c;
+    let delta = if denom != 0.0 {
+        0.5 * (a - c) / denom
+    } else {
+        0.0
+    };
+    Some((best as f64 + delta.clamp(-0.5, 0.5)) * sample_rate / n as f64)
 }
 
 fn worst_load(report: &ressort_engine::StabilityReport) -> (f64, String) {

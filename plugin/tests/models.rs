@@ -159,3 +159,21 @@ fn a_bad_script_keeps_the_running_model_and_reports_where() {
     assert_eq!(store.running().name, "string-1000");
     assert!(store.status().diagnostics.is_empty());
 }
+
+/// The reference pitch found by rendering an impulse response equals the closed form of the
+/// oscillator it is made of: sin²(πf/SR) = K'/4M with K' = K·(44100/SR)² (spec §1.7, §5.3).
+#[test]
+fn the_estimated_reference_pitch_of_an_oscillator_matches_the_closed_form() {
+    let text = "@o osc 1 0.01 0.00001 0 0\n@in1 frcInput @o\n@out1 posOutput @o\n";
+    for sr in [44_100.0, 48_000.0, 96_000.0] {
+        let p = prepare("osc", text, sr).unwrap();
+        let k = 0.01 * (44_100.0 / sr) * (44_100.0f64 / sr);
+        let exact = (k / 4.0).sqrt().asin() * sr / std::f64::consts::PI;
+        let got = p.settings.reference_pitch_hz.expect("a pitch");
+        let cents = 1200.0 * (got / exact).log2();
+        println!(
+            "osc K=0.01 at {sr} Hz: estimated {got:.3} Hz, exact {exact:.3} Hz ({cents:+.2} cents)"
+        );
+        assert!(cents.abs() < 1.0, "{cents} cents");
+    }
+}
