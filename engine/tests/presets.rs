@@ -51,7 +51,12 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("mesh-15x15.mdl", Some((227, 422))),
     ("mesh-25x20.mdl", Some((502, 957))),
     // §7.6 Oscillator tutorial series: no counts given.
+    ("harmonic-oscillator.mdl", None),
     ("hammer-oscillator.mdl", None),
+    ("gravity-oscillator.mdl", None),
+    ("plucked-oscillator.mdl", None),
+    ("bowed-oscillator.mdl", None),
+    ("nonlinear-oscillator.mdl", None),
 ];
 
 #[test]
