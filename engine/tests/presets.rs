@@ -50,6 +50,10 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("string-1000.mdl", Some((1004, 1003))),
     ("mesh-15x15.mdl", Some((227, 422))),
     ("mesh-25x20.mdl", Some((502, 957))),
+    // §7.2 basics.
+    ("oscillator-bank.mdl", Some((8, 0))),
+    ("bowed-string.mdl", Some((156, 158))),
+    ("plucked-harmonics.mdl", Some((156, 158))),
     // §7.6 Oscillator tutorial series: no counts given.
     ("harmonic-oscillator.mdl", None),
     ("hammer-oscillator.mdl", None),
