@@ -54,6 +54,10 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("oscillator-bank.mdl", Some((8, 0))),
     ("bowed-string.mdl", Some((156, 158))),
     ("plucked-harmonics.mdl", Some((156, 158))),
+    // §7.3 intermediate.
+    ("fretted-string.mdl", Some((169, 203))),
+    // §7.4 advanced.
+    ("chladni-150x150.mdl", Some((22_503, 44_703))),
     // §7.6 Oscillator tutorial series: no counts given.
     ("harmonic-oscillator.mdl", None),
     ("hammer-oscillator.mdl", None),
@@ -282,5 +286,20 @@ fn canonical_scripts_equal_the_builder_reference_models() {
         ("hammer-oscillator.mdl", reference::hammer_oscillator()),
     ] {
         assert_eq!(preset(file), spec, "{file} differs from the builder model");
+    }
+}
+
+#[test]
+fn gallery_scripts_equal_the_builder_reference_models() {
+    for (file, spec) in [
+        ("fretted-string.mdl", reference::fretted_string()),
+        ("chladni-150x150.mdl", reference::chladni_150()),
+    ] {
+        let parsed = preset(file);
+        // Element by element first, for a readable failure on a 200-line model.
+        for (i, (a, b)) in parsed.elements.iter().zip(&spec.elements).enumerate() {
+            assert_eq!(a, b, "{file}: element {i} differs from the builder model");
+        }
+        assert_eq!(parsed, spec, "{file} differs from the builder model");
     }
 }
