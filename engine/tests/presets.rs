@@ -56,6 +56,8 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("plucked-harmonics.mdl", Some((156, 158))),
     // §7.3 intermediate.
     ("fretted-string.mdl", Some((169, 203))),
+    ("drunk-triangles-xl.mdl", Some((68, 149))),
+    ("drunk-triangles.mdl", Some((5, 5))),
     // §7.4 advanced.
     ("chladni-150x150.mdl", Some((22_503, 44_703))),
     // §7.6 Oscillator tutorial series: no counts given.
