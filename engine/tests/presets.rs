@@ -59,7 +59,13 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("drunk-triangles-xl.mdl", Some((68, 149))),
     ("drunk-triangles.mdl", Some((5, 5))),
     // §7.4 advanced.
+    ("brokendown-string.mdl", Some((401, 401))),
     ("chladni-150x150.mdl", Some((22_503, 44_703))),
+    ("coupled-strings-bowed.mdl", Some((285, 572))),
+    ("nofx-drone.mdl", Some((463, 463))),
+    ("resonant-strings.mdl", Some((804, 968))),
+    ("rolling-mesh.mdl", Some((101, 181))),
+    ("two-fingers-string.mdl", Some((127, 258))),
     // §7.6 Oscillator tutorial series: no counts given.
     ("harmonic-oscillator.mdl", None),
     ("hammer-oscillator.mdl", None),
