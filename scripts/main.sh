@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Sets up and runs the main job on a machine with no audio device: checks, renders and
 # benchmarks reference models with the `ressort` command line, then measures every reference
-# model of the specification (spec §7) on the engine. Extra arguments go to the engine
-# benchmark (`--save` writes engine/benches/RESULTS.md).
+# model of the specification (spec §7) on the engine and the load time (parse + compile) of
+# every preset script in models/. Extra arguments go to both engine benchmarks (`--save` writes
+# engine/benches/RESULTS.md and engine/benches/LOAD_TIME.md; a bare word keeps only the models
+# whose name contains it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -14,3 +16,4 @@ mkdir -p out
 "$ressort" render models/string-1000.mdl -o out/string-1000.wav --seconds 3 --impulse in1=-0.01
 "$ressort" bench models/string-1000.mdl
 cargo bench -p ressort-engine --bench reference_models --locked -- "$@"
+cargo bench -p ressort-engine --bench load_time --locked -- "$@"

@@ -1,10 +1,14 @@
 //! The preset library in `models/`: every file documents itself, parses without errors, passes
-//! the stability check and renders finite, non-silent audio when excited.
+//! the stability check, has the counts spec §7 gives, and renders finite, non-silent audio when
+//! played the way its header says.
 
 mod common;
 
 use common::{engine, render};
-use ressort_engine::{parse, reference, InputUse};
+use ressort_engine::spec::REFERENCE_SAMPLE_RATE_HZ;
+use ressort_engine::{
+    parse, reference, ElementKind, Endpoint, InputUse, Law, ModelSpec, OutputUse, ParamKind,
+};
 use std::path::PathBuf;
 
 fn presets() -> Vec<(String, String)> {
@@ -24,6 +28,53 @@ fn presets() -> Vec<(String, String)> {
     files
 }
 
+fn preset(name: &str) -> ModelSpec {
+    let files = presets();
+    let (_, text) = files
+        .iter()
+        .find(|f| f.0 == name)
+        .unwrap_or_else(|| panic!("models/{name} is missing"));
+    let parsed = parse(text);
+    let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
+    parsed
+        .spec
+        .unwrap_or_else(|| panic!("{name} does not parse: {errors:?}"))
+}
+
+/// Points / interactions of every preset, as spec §7 states them (§7.0 conventions: avatars and
+/// macro nodes count, connection points and force inputs do not). `None` for the tutorial
+/// models whose section gives no count. Every file in `models/` must be listed here, so a
+/// preset cannot be added or lost without this table noticing.
+const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
+    // §7.10, canonical definitions.
+    ("string-1000.mdl", Some((1004, 1003))),
+    ("mesh-15x15.mdl", Some((227, 422))),
+    ("mesh-25x20.mdl", Some((502, 957))),
+    // §7.2 basics.
+    ("oscillator-bank.mdl", Some((8, 0))),
+    ("bowed-string.mdl", Some((156, 158))),
+    ("plucked-harmonics.mdl", Some((156, 158))),
+    // §7.3 intermediate.
+    ("fretted-string.mdl", Some((169, 203))),
+    ("drunk-triangles-xl.mdl", Some((68, 149))),
+    ("drunk-triangles.mdl", Some((5, 5))),
+    // §7.4 advanced.
+    ("brokendown-string.mdl", Some((401, 401))),
+    ("chladni-150x150.mdl", Some((22_503, 44_703))),
+    ("coupled-strings-bowed.mdl", Some((285, 572))),
+    ("nofx-drone.mdl", Some((463, 463))),
+    ("resonant-strings.mdl", Some((804, 968))),
+    ("rolling-mesh.mdl", Some((101, 181))),
+    ("two-fingers-string.mdl", Some((127, 258))),
+    // §7.6 Oscillator tutorial series: no counts given.
+    ("harmonic-oscillator.mdl", None),
+    ("hammer-oscillator.mdl", None),
+    ("gravity-oscillator.mdl", None),
+    ("plucked-oscillator.mdl", None),
+    ("bowed-oscillator.mdl", None),
+    ("nonlinear-oscillator.mdl", None),
+];
+
 #[test]
 fn every_preset_starts_with_a_description() {
     for (name, text) in presets() {
@@ -36,63 +87,227 @@ fn every_preset_starts_with_a_description() {
 }
 
 #[test]
+fn every_preset_has_the_counts_of_the_specification() {
+    let files = presets();
+    for (name, _) in &files {
+        assert!(
+            COUNTS.iter().any(|(n, _)| n == name),
+            "models/{name} is not in the COUNTS table"
+        );
+    }
+    for (name, counts) in COUNTS {
+        let spec = preset(name);
+        let Some(expected) = counts else { continue };
+        let e = engine(&spec, 44_100.0);
+        let found = (e.info().num_points, e.info().num_interactions);
+        assert_eq!(found, *expected, "{name}: points / interactions");
+    }
+}
+
+/// A parameter's declared value; audio-rate parameters read as 0.5 (the test feeds them 0.5).
+fn lookup(spec: &ModelSpec) -> impl Fn(&str) -> Option<f64> + '_ {
+    move |name| {
+        spec.param(name).map(|p| match p.kind {
+            ParamKind::Control { value } => value,
+            ParamKind::Audio { .. } => AUDIO_PARAM_VALUE,
+        })
+    }
+}
+
+const AUDIO_PARAM_VALUE: f64 = 0.5;
+/// Strong enough for every hanging hammer: a suspension of damping Z stops a kick of I after
+/// |I|/Z units, and the hammer oscillators hang 1 unit above with Z = 0.05.
+const FORCE_IMPULSE: f64 = -0.1;
+
+/// What an avatar does, read from the interactions it drives.
+enum Role {
+    /// It bows through `nlBow` with this Vscale (script value).
+    Bow { vscale: f64 },
+    /// It plucks through `nlPluck` with this Pscale.
+    Pluck { pscale: f64 },
+    /// A damper, jaw, finger or contact: it stays where it was declared.
+    Hold,
+}
+
+fn role(spec: &ModelSpec, avatar: &str) -> Role {
+    let value = lookup(spec);
+    let me = Endpoint::label(avatar);
+    for e in &spec.elements {
+        if let ElementKind::Interaction { law, a, b } = &e.kind {
+            if *a != me && *b != me {
+                continue;
+            }
+            match law {
+                Law::NlBow { scale, .. } => {
+                    return Role::Bow {
+                        vscale: scale.eval(&value),
+                    }
+                }
+                Law::NlPluck { scale, .. } => {
+                    return Role::Pluck {
+                        pscale: scale.eval(&value),
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    Role::Hold
+}
+
+/// The input signals that play a preset, following the headers' "How to play": a downward
+/// force impulse on force inputs; bows moved from their start at half their Vscale (inside the
+/// slip band Vscale/3…Vscale, where the bow self-oscillates); plectra swept smoothly through
+/// the string (from p to −p, or 4·Pscale down when they start on it); every other avatar held
+/// at its declared position (an input at 0 would make it jump there in one sample); audio-rate
+/// parameters at 0.5.
+fn excitation(spec: &ModelSpec, inputs: &[Vec<InputUse>], sr: f64, frames: usize) -> Vec<Vec<f64>> {
+    let value = lookup(spec);
+    let z_scale = REFERENCE_SAMPLE_RATE_HZ / sr;
+    inputs
+        .iter()
+        .map(|uses| match uses.first() {
+            Some(InputUse::Force(_)) => {
+                let mut v = vec![0.0; frames];
+                v[0] = FORCE_IMPULSE;
+                v
+            }
+            Some(InputUse::Position(label)) => {
+                let start = match &spec.element(label).expect("avatar").kind {
+                    ElementKind::PosInput { pos, .. } => pos.z().eval(&value),
+                    other => panic!("@{label} is a {}", other.keyword()),
+                };
+                match role(spec, label) {
+                    Role::Bow { vscale } => {
+                        // Speed rising over 50 ms to 0.5·Vscale per step at this rate.
+                        let speed = 0.5 * vscale * z_scale;
+                        let attack = 0.05 * sr;
+                        let mut x = start;
+                        (0..frames)
+                            .map(|n| {
+                                let v = x;
+                                x += speed * (n as f64 / attack).min(1.0);
+                                v
+                            })
+                            .collect()
+                    }
+                    Role::Pluck { pscale } => {
+                        let end = if start.abs() > pscale {
+                            -start
+                        } else {
+                            start - 4.0 * pscale
+                        };
+                        // A raised-cosine sweep over 100 ms, starting after 10 ms.
+                        (0..frames)
+                            .map(|n| {
+                                let s = ((n as f64 / sr - 0.01) / 0.1).clamp(0.0, 1.0);
+                                let w = 0.5 - 0.5 * (std::f64::consts::PI * s).cos();
+                                start + (end - start) * w
+                            })
+                            .collect()
+                    }
+                    Role::Hold => vec![start; frames],
+                }
+            }
+            Some(InputUse::Param(_)) => vec![AUDIO_PARAM_VALUE; frames],
+            None => vec![0.0; frames],
+        })
+        .collect()
+}
+
+/// The smallest excursion that counts as sound on an output that reads the model (not an
+/// avatar). A disconnected output or an excitation that never reaches the structure gives 0.
+const SILENCE: f64 = 1e-7;
+
+#[test]
 fn every_preset_is_stable_and_sounds() {
+    const SR: f64 = 48_000.0;
+    const FRAMES: usize = 48_000;
     for (name, text) in presets() {
         let parsed = parse(&text);
         let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
         assert!(errors.is_empty(), "{name}: {errors:?}");
+        let warnings: Vec<String> = parsed.warnings().map(|d| d.to_string()).collect();
+        assert!(warnings.is_empty(), "{name}: {warnings:?}");
         let spec = parsed.spec.unwrap();
-        let mut e = engine(&spec, 48_000.0);
+        let mut e = engine(&spec, SR);
         let report = e.stability();
         assert!(report.is_stable(), "{name}: {:?}", report.warnings);
-        // Excite: a downward force impulse on every force input, slow motion on avatars.
-        let frames = 48_000;
-        let inputs: Vec<Vec<f64>> = e
-            .info()
-            .inputs
-            .iter()
-            .map(|uses| match uses.first() {
-                Some(InputUse::Force(_)) => {
-                    let mut v = vec![0.0; frames];
-                    v[0] = -0.05;
-                    v
-                }
-                Some(InputUse::Position(_)) => (0..frames)
-                    .map(|n| 0.01 * (n as f64 / 4800.0).sin())
-                    .collect(),
-                Some(InputUse::Param(_)) => vec![0.5; frames],
-                None => vec![0.0; frames],
-            })
-            .collect();
-        let out = render(&mut e, frames, 512, &inputs);
+
+        let inputs = excitation(&spec, &e.info().inputs, SR, FRAMES);
+        let out = render(&mut e, FRAMES, 512, &inputs);
         assert!(
             !e.is_tripped(),
             "{name}: guard tripped {:?}",
             e.guard_event()
         );
+        // Audio-rate parameters now hold their driven values: check again with them.
+        let report = e.stability();
+        assert!(
+            report.is_stable(),
+            "{name} (as played): {:?}",
+            report.warnings
+        );
+
+        let info = e.info().clone();
+        let mut loudest = (0.0f64, 0.0f64);
         for (c, ch) in out.iter().enumerate() {
             assert!(
                 ch.iter().all(|v| v.is_finite()),
                 "{name}: out{} not finite",
                 c + 1
             );
+            // Outputs that read an avatar only echo their input.
+            if let OutputUse::Position(target) = &info.outputs[c] {
+                let avatar = spec
+                    .element(target.trim_start_matches('@'))
+                    .is_some_and(|el| matches!(el.kind, ElementKind::PosInput { .. }));
+                if avatar {
+                    continue;
+                }
+            }
+            let peak = ch.iter().fold(0.0f64, |m, v| m.max((v - ch[0]).abs()));
+            let mean = ch.iter().sum::<f64>() / ch.len() as f64;
+            let rms = (ch.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / ch.len() as f64).sqrt();
+            assert!(
+                peak > SILENCE,
+                "{name}: out{} is silent (peak excursion {peak:e})",
+                c + 1
+            );
+            if peak > loudest.0 {
+                loudest = (peak, rms);
+            }
         }
-        let peak = out.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-        assert!(peak > 1e-6, "{name}: silent (peak {peak:e})");
+        println!(
+            "{name:<28} loudest output: peak excursion {:.3e}, AC RMS {:.3e}",
+            loudest.0, loudest.1
+        );
     }
 }
 
 #[test]
 fn canonical_scripts_equal_the_builder_reference_models() {
-    let files = presets();
-    let text = |n: &str| &files.iter().find(|f| f.0 == n).unwrap().1;
     for (file, spec) in [
         ("string-1000.mdl", reference::string_1000()),
         ("mesh-15x15.mdl", reference::mesh_15x15()),
         ("mesh-25x20.mdl", reference::mesh_25x20()),
         ("hammer-oscillator.mdl", reference::hammer_oscillator()),
     ] {
-        let parsed = parse(text(file)).spec.unwrap();
+        assert_eq!(preset(file), spec, "{file} differs from the builder model");
+    }
+}
+
+#[test]
+fn gallery_scripts_equal_the_builder_reference_models() {
+    for (file, spec) in [
+        ("fretted-string.mdl", reference::fretted_string()),
+        ("chladni-150x150.mdl", reference::chladni_150()),
+    ] {
+        let parsed = preset(file);
+        // Element by element first, for a readable failure on a 200-line model.
+        for (i, (a, b)) in parsed.elements.iter().zip(&spec.elements).enumerate() {
+            assert_eq!(a, b, "{file}: element {i} differs from the builder model");
+        }
         assert_eq!(parsed, spec, "{file} differs from the builder model");
     }
 }

@@ -1,0 +1,206 @@
+//! Load-time benchmark of the preset scripts in `models/`: how long a model takes from script
+//! text to a ready-to-run engine. For each `models/*.mdl` it measures parsing alone
+//! (`parse_bytes`, what the command line and a host do with a file's bytes), compiling alone
+//! (`compile` of the parsed spec at 48 kHz) and both in sequence, and reports the median of
+//! many runs of each.
+//!
+//! ```text
+//! cargo bench -p ressort-engine --bench load_time            # print the table
+//! cargo bench -p ressort-engine --bench load_time -- --save  # also write LOAD_TIME.md
+//! cargo bench -p ressort-engine --bench load_time -- string  # only files containing "string"
+//! ```
+//!
+//! Requirement (issue 3): parse plus compile in under 5 ms for the 1000-mass string and under
+//! 100 ms for the 150×150 Chladni model. The verdicts are printed and saved; the benchmark does
+//! not fail on them, because a timing is a measurement of a machine, not a test.
+//!
+//! Each measurement runs once to warm up, then as many times as fit in about 0.2 s of wall time
+//! (at least 21, at most 2001 runs); the median run is reported, with the 90th percentile of
+//! parse plus compile. Reading the file is not timed, and neither is dropping the results.
+
+use ressort_engine::{compile, parse_bytes, CompileOptions, ModelSpec};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+const SAMPLE_RATE_HZ: f64 = 48_000.0;
+const MIN_RUNS: usize = 21;
+const MAX_RUNS: usize = 2001;
+const WALL_TIME: Duration = Duration::from_millis(200);
+
+/// The requirement: (file, limit in ms for parse plus compile).
+const LIMITS: &[(&str, f64)] = &[("string-1000.mdl", 5.0), ("chladni-150x150.mdl", 100.0)];
+
+struct Row {
+    file: String,
+    bytes: usize,
+    points: usize,
+    interactions: usize,
+    runs: usize,
+    parse_ms: f64,
+    compile_ms: f64,
+    total_ms: f64,
+    total_p90_ms: f64,
+}
+
+/// Sorted timings of `f` in ms: one warm-up run, then as many runs as fit in WALL_TIME.
+fn time_runs<T>(mut f: impl FnMut() -> T) -> Vec<f64> {
+    let once = |f: &mut dyn FnMut() -> T| {
+        let t = Instant::now();
+        let result = f();
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        drop(result);
+        ms
+    };
+    let first = once(&mut f);
+    let runs =
+        ((WALL_TIME.as_secs_f64() * 1e3 / first.max(1e-6)) as usize).clamp(MIN_RUNS, MAX_RUNS) | 1;
+    let mut v: Vec<f64> = (0..runs).map(|_| once(&mut f)).collect();
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+fn median(sorted: &[f64]) -> f64 {
+    sorted[sorted.len() / 2]
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    sorted[((sorted.len() - 1) as f64 * p).round() as usize]
+}
+
+fn parse_ok(file: &str, bytes: &[u8]) -> ModelSpec {
+    let parsed = parse_bytes(bytes);
+    parsed.spec.unwrap_or_else(|| {
+        let errors: Vec<String> = parsed.diagnostics.iter().map(|d| d.to_string()).collect();
+        panic!("{file} does not parse: {errors:?}")
+    })
+}
+
+fn measure(path: &Path) -> Row {
+    let file = path.file_name().unwrap().to_string_lossy().into_owned();
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {file}: {e}"));
+    let options = CompileOptions::at(SAMPLE_RATE_HZ);
+    let spec = parse_ok(&file, &bytes);
+    let engine = compile(&spec, &options).unwrap_or_else(|e| panic!("{file}: {e}"));
+    let (points, interactions) = (engine.info().num_points, engine.info().num_interactions);
+    drop(engine);
+
+    let parse = time_runs(|| parse_bytes(&bytes));
+    let compile_only = time_runs(|| compile(&spec, &options));
+    let total = time_runs(|| compile(&parse_ok(&file, &bytes), &options));
+    Row {
+        file,
+        bytes: bytes.len(),
+        points,
+        interactions,
+        runs: total.len(),
+        parse_ms: median(&parse),
+        compile_ms: median(&compile_only),
+        total_ms: median(&total),
+        total_p90_ms: percentile(&total, 0.9),
+    }
+}
+
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".to_string())
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let save = args.iter().any(|a| a == "--save");
+    // `cargo bench` passes `--bench`; every other `--` flag is ignored too.
+    let filters: Vec<&String> = args.iter().filter(|a| !a.starts_with("--")).collect();
+
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "mdl"))
+        .collect();
+    files.sort();
+
+    let mut rows = Vec::new();
+    for path in &files {
+        let name = path.file_name().unwrap().to_string_lossy();
+        if !filters.is_empty() && !filters.iter().any(|f| name.contains(f.as_str())) {
+            continue;
+        }
+        let row = measure(path);
+        eprintln!(
+            "{:<28} parse {:>8.4} ms  compile {:>8.4} ms  parse+compile {:>8.4} ms ({} runs)",
+            row.file, row.parse_ms, row.compile_ms, row.total_ms, row.runs
+        );
+        rows.push(row);
+    }
+
+    let mut table = String::new();
+    table.push_str(
+        "| model | bytes | points | interactions | parse ms | compile ms | parse + compile ms | p90 ms | runs |\n",
+    );
+    table.push_str("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for r in &rows {
+        table.push_str(&format!(
+            "| {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} |\n",
+            r.file,
+            r.bytes,
+            r.points,
+            r.interactions,
+            r.parse_ms,
+            r.compile_ms,
+            r.total_ms,
+            r.total_p90_ms,
+            r.runs
+        ));
+    }
+    let mut verdicts = String::new();
+    for (file, limit) in LIMITS {
+        if let Some(r) = rows.iter().find(|r| r.file == *file) {
+            let verdict = if r.total_p90_ms < *limit {
+                format!("met, {:.0}× under the limit", limit / r.total_p90_ms)
+            } else {
+                "NOT MET".to_string()
+            };
+            verdicts.push_str(&format!(
+                "- {file}: parse + compile {:.4} ms (median; p90 {:.4} ms) against a limit of \
+                 {limit} ms: {verdict}.\n",
+                r.total_ms, r.total_p90_ms,
+            ));
+        }
+    }
+    println!("{table}");
+    print!("{verdicts}");
+
+    if save {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/LOAD_TIME.md");
+        let text = format!(
+            "# Load-time benchmark\n\n\
+             Produced by `cargo bench -p ressort-engine --bench load_time -- --save` (also \
+             `bash scripts/main.sh --save`).\n\n\
+             Machine: {} ({} logical cores). Every `models/*.mdl` file is read once; then \
+             `parse_bytes` of its bytes (parse), `compile` of the parsed spec at {} Hz \
+             (compile), and both in sequence (parse + compile) are each timed over many runs \
+             (at least {MIN_RUNS}, as many as fit in about {} ms, at most {MAX_RUNS}) after a \
+             warm-up. The table gives the median run, the 90th percentile of parse + compile \
+             and the run count of parse + compile.\n\n\
+             Requirement: parse plus compile in under 5 ms for the 1000-mass string and under \
+             100 ms for the 150×150 Chladni model. A verdict is \"met\" when the 90th \
+             percentile is below the limit.\n\n\
+             {table}\n{verdicts}",
+            cpu_model(),
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1),
+            SAMPLE_RATE_HZ,
+            WALL_TIME.as_millis(),
+        );
+        std::fs::write(path, text).expect("write LOAD_TIME.md");
+        eprintln!("wrote {path}");
+    }
+}
