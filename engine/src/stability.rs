@@ -42,6 +42,11 @@ pub struct MassStability {
     pub k_eq: f64,
     /// Sum of attached dampings (per step).
     pub z_eq: f64,
+    /// Stiffness of the links to other moving points: the off-diagonal row sum of the
+    /// stiffness matrix (per step).
+    pub k_coupled: f64,
+    /// Damping of the links to other moving points (per step).
+    pub z_coupled: f64,
 }
 
 impl MassStability {
@@ -58,6 +63,15 @@ impl MassStability {
     /// True when 4M > K_eq + 2·Z_eq.
     pub fn is_stable(&self) -> bool {
         self.margin() > 0.0
+    }
+
+    /// The Gershgorin bound of this mass's row: (K_eq + K_coupled + 2·(Z_eq + Z_coupled)) / 4M.
+    /// Below 1 for every mass, no mode of the linearised network exceeds the step's limit,
+    /// which the per-mass rule alone does not guarantee for coupled masses (a uniform chain
+    /// passes the per-mass rule up to K = 2M but is stable only up to K = M). For uniform
+    /// strings and meshes it equals the structure load.
+    pub fn coupled_load(&self) -> f64 {
+        (self.k_eq + self.k_coupled + 2.0 * (self.z_eq + self.z_coupled)) / (4.0 * self.m)
     }
 }
 
@@ -179,7 +193,57 @@ fn analyze(e: &Engine) -> StabilityReport {
     let args = &e.args;
     let mut k_eq = vec![0.0; n];
     let mut z_eq = vec![0.0; n];
+    let mut k_cp = vec![0.0; n];
+    let mut z_cp = vec![0.0; n];
     let mut warnings = Vec::new();
+
+    let is_moving = |p: usize| -> bool {
+        match info.points[p].kind {
+            PointKind::Mass | PointKind::Osc | PointKind::MassG => true,
+            PointKind::MacroNode { fixed } => !fixed,
+            PointKind::Ground | PointKind::Avatar => false,
+        }
+    };
+    // The share of an endpoint that moves: 1 or 0 for a point, the weights of its moving
+    // nodes for a connection point.
+    let moving_weight = |p: u32| -> f64 {
+        let p = p as usize;
+        if p < n {
+            is_moving(p) as u32 as f64
+        } else if let Some(i) = p
+            .checked_sub(e.proxies.base)
+            .filter(|&i| i < e.proxies.len())
+        {
+            e.proxies.nodes[i]
+                .iter()
+                .zip(e.proxies.weights[i])
+                .filter(|(node, _)| is_moving(**node as usize))
+                .map(|(_, w)| w)
+                .sum()
+        } else {
+            0.0
+        }
+    };
+    // Off-diagonal row sums of a link a–b on a's side: towards b, and, for a connection
+    // point, among a's own nodes.
+    let couple = |a: u32, b: u32, k: f64, z: f64, k_cp: &mut [f64], z_cp: &mut [f64]| {
+        let other = moving_weight(b);
+        let p = a as usize;
+        if p < n {
+            k_cp[p] += k * other;
+            z_cp[p] += z * other;
+        } else if let Some(i) = p
+            .checked_sub(e.proxies.base)
+            .filter(|&i| i < e.proxies.len())
+        {
+            let own = moving_weight(a);
+            for (node, w) in e.proxies.nodes[i].iter().zip(e.proxies.weights[i]) {
+                let f = w * (other + own - w).max(0.0);
+                k_cp[*node as usize] += f * k;
+                z_cp[*node as usize] += f * z;
+            }
+        }
+    };
 
     // Adds (k, z) to a point, spreading over macro nodes for connection points.
     let add = |p: u32, k: f64, z: f64, k_eq: &mut [f64], z_eq: &mut [f64]| {
@@ -214,6 +278,8 @@ fn analyze(e: &Engine) -> StabilityReport {
             let (k, z) = (col(g, 0, i), col(g, 1, i));
             add(g.a[i], k, z, &mut k_eq, &mut z_eq);
             add(g.b[i], k, z, &mut k_eq, &mut z_eq);
+            couple(g.a[i], g.b[i], k, z, &mut k_cp, &mut z_cp);
+            couple(g.b[i], g.a[i], k, z, &mut k_cp, &mut z_cp);
         }
     }
     let g = &ix.nl_contact;
@@ -235,6 +301,8 @@ fn analyze(e: &Engine) -> StabilityReport {
         };
         add(g.a[i], kb, z, &mut k_eq, &mut z_eq);
         add(g.b[i], kb, z, &mut k_eq, &mut z_eq);
+        couple(g.a[i], g.b[i], kb, z, &mut k_cp, &mut z_cp);
+        couple(g.b[i], g.a[i], kb, z, &mut k_cp, &mut z_cp);
     }
     for (g, keyword) in [(&ix.nl_spring2, "nlSpring2"), (&ix.nl_spring3, "nlSpring3")] {
         for i in 0..g.len() {
@@ -247,6 +315,8 @@ fn analyze(e: &Engine) -> StabilityReport {
             }
             add(g.a[i], k, z, &mut k_eq, &mut z_eq);
             add(g.b[i], k, z, &mut k_eq, &mut z_eq);
+            couple(g.a[i], g.b[i], k, z, &mut k_cp, &mut z_cp);
+            couple(g.b[i], g.a[i], k, z, &mut k_cp, &mut z_cp);
         }
     }
     let g = &ix.nl_spring_damper;
@@ -271,12 +341,16 @@ fn analyze(e: &Engine) -> StabilityReport {
         };
         add(g.a[i], kb, zb, &mut k_eq, &mut z_eq);
         add(g.b[i], kb, zb, &mut k_eq, &mut z_eq);
+        couple(g.a[i], g.b[i], kb, zb, &mut k_cp, &mut z_cp);
+        couple(g.b[i], g.a[i], kb, zb, &mut k_cp, &mut z_cp);
     }
     let g = &ix.pluck;
     for i in 0..g.len() {
         let (k, z) = (0.9 * col(g, 0, i).abs(), col(g, 2, i));
         add(g.a[i], k, z, &mut k_eq, &mut z_eq);
         add(g.b[i], k, z, &mut k_eq, &mut z_eq);
+        couple(g.a[i], g.b[i], k, z, &mut k_cp, &mut z_cp);
+        couple(g.b[i], g.a[i], k, z, &mut k_cp, &mut z_cp);
     }
     let g = &ix.bow;
     for i in 0..g.len() {
@@ -288,6 +362,8 @@ fn analyze(e: &Engine) -> StabilityReport {
         };
         add(g.a[i], 0.0, stick, &mut k_eq, &mut z_eq);
         add(g.b[i], 0.0, stick, &mut k_eq, &mut z_eq);
+        couple(g.a[i], g.b[i], 0.0, stick, &mut k_cp, &mut z_cp);
+        couple(g.b[i], g.a[i], 0.0, stick, &mut k_cp, &mut z_cp);
     }
 
     // Single masses: osc terms.
@@ -320,14 +396,21 @@ fn analyze(e: &Engine) -> StabilityReport {
             let links = (j > 0) as u32 + (j + 1 < nn) as u32;
             k_eq[p] += links as f64 * k;
             z_eq[p] += links as f64 * z + zo;
+            let moving = (j > 0 && is_moving(p - 1)) as u32 as f64
+                + (j + 1 < nn && is_moving(p + 1)) as u32 as f64;
+            k_cp[p] += moving * k;
+            z_cp[p] += moving * z;
         }
         if stiff {
             let last = nn as isize - 1;
             for i in -1..=last {
                 let (a, b) = (i.clamp(0, last) as usize, (i + 2).clamp(0, last) as usize);
                 if a != b {
-                    k_eq[mac.base + a] += k2;
-                    k_eq[mac.base + b] += k2;
+                    let (pa, pb) = (mac.base + a, mac.base + b);
+                    k_eq[pa] += k2;
+                    k_eq[pb] += k2;
+                    k_cp[pa] += k2 * is_moving(pb) as u32 as f64;
+                    k_cp[pb] += k2 * is_moving(pa) as u32 as f64;
                 }
             }
         }
@@ -362,6 +445,18 @@ fn analyze(e: &Engine) -> StabilityReport {
                     (i > 0) as u32 + (i + 1 < l) as u32 + (j > 0) as u32 + (j + 1 < w) as u32;
                 k_eq[p] += links as f64 * k;
                 z_eq[p] += links as f64 * z + zo;
+                let moving = [
+                    (i > 0).then(|| p - w),
+                    (i + 1 < l).then(|| p + w),
+                    (j > 0).then(|| p - 1),
+                    (j + 1 < w).then(|| p + 1),
+                ]
+                .into_iter()
+                .flatten()
+                .filter(|&q| is_moving(q))
+                .count() as f64;
+                k_cp[p] += moving * k;
+                z_cp[p] += moving * z;
             }
         }
         let load = (8.0 * k + 2.0 * (8.0 * z + zo)) / (4.0 * mm);
@@ -376,13 +471,8 @@ fn analyze(e: &Engine) -> StabilityReport {
     }
 
     let mut masses = Vec::new();
-    for (p, point) in info.points.iter().enumerate() {
-        let moving = match point.kind {
-            PointKind::Mass | PointKind::Osc | PointKind::MassG => true,
-            PointKind::MacroNode { fixed } => !fixed,
-            PointKind::Ground | PointKind::Avatar => false,
-        };
-        if !moving {
+    for p in 0..info.points.len() {
+        if !is_moving(p) {
             continue;
         }
         let entry = MassStability {
@@ -391,6 +481,8 @@ fn analyze(e: &Engine) -> StabilityReport {
             m: mass[p],
             k_eq: k_eq[p],
             z_eq: z_eq[p],
+            k_coupled: k_cp[p],
+            z_coupled: z_cp[p],
         };
         if !entry.is_stable() {
             warnings.push(StabilityWarning::MassRule(entry.clone()));

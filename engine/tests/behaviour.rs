@@ -479,3 +479,56 @@ fn reference_models_have_the_published_counts() {
         );
     }
 }
+
+/// The coupled (Gershgorin) load counts links to other moving masses: for a chain of single
+/// masses it is the uniform-string limit (λ_K = 4K), which the per-mass rule underestimates by
+/// half; the same model as a `string` macro gives the same load. A chain just below its
+/// coupled limit runs; just above the per-mass rule's silence about it, it explodes.
+#[test]
+fn coupled_loads_bound_chains_of_single_masses() {
+    let text = |k: f64| {
+        format!(
+            "~samplerate raw\n@g0 ground 0\n@m1 mass 1 0 0\n@m2 mass 1 0 0\n@m3 mass 1 0 0\n\
+             @g1 ground 0\n@r0 spring @g0 @m1 {k}\n@r1 spring @m1 @m2 {k}\n@r2 spring @m2 @m3 {k}\n\
+             @r3 spring @m3 @g1 {k}\n@in1 frcInput @m2\n@out1 posOutput @m2\n"
+        )
+    };
+    let k = 0.3;
+    let spec = ressort_engine::parse(&text(k)).spec.unwrap();
+    let mut e = engine(&spec, 44_100.0);
+    let r = e.stability();
+    let mid = r.masses.iter().find(|m| m.label == "m2").unwrap();
+    assert_eq!((mid.k_eq, mid.k_coupled), (2.0 * k, 2.0 * k));
+    let end = r.masses.iter().find(|m| m.label == "m1").unwrap();
+    assert_eq!((end.k_eq, end.k_coupled), (2.0 * k, k));
+    assert!((mid.coupled_load() - 4.0 * k / 4.0).abs() < 1e-12);
+
+    let mut b = ModelBuilder::new();
+    b.raw();
+    b.macro_1d("s", MacroKind::String, 5, 1.0, k, 0.0);
+    b.frc_input(1, Endpoint::at("s", 0.5));
+    b.pos_output(1, Endpoint::at("s", 0.5));
+    let mut m = engine(&b.build(), 44_100.0);
+    let worst = m
+        .stability()
+        .masses
+        .iter()
+        .map(|m| m.coupled_load())
+        .fold(0.0, f64::max);
+    assert!((worst - 4.0 * k / 4.0).abs() < 1e-12, "{worst}");
+
+    // K = 1.9: the per-mass rule passes (2K = 3.8 < 4M); the coupled load (1.9) says no, and
+    // the chain's fastest mode (λ = (2 + √2)K ≈ 6.5 > 4) explodes.
+    let spec = ressort_engine::parse(&text(1.9)).spec.unwrap();
+    let mut e = engine(&spec, 44_100.0);
+    let r = e.stability();
+    assert!(r.is_stable());
+    assert!(r.masses.iter().any(|m| m.coupled_load() > 1.0));
+    let out = render(&mut e, 4_000, 64, &[impulse(-1e-3, 4_000)]);
+    assert!(e.is_tripped() || out[0].iter().any(|x| x.abs() > 1.0));
+    // K = 0.55: coupled load 0.55 everywhere, and the chain rings without growing.
+    let spec = ressort_engine::parse(&text(0.55)).spec.unwrap();
+    let mut e = engine(&spec, 44_100.0);
+    let out = render(&mut e, 20_000, 64, &[impulse(-1e-3, 20_000)]);
+    assert!(!e.is_tripped() && out[0].iter().all(|x| x.abs() < 1e-2));
+}
