@@ -4,7 +4,8 @@
 # model of the specification (spec §7) on the engine and the load time (parse + compile) of
 # every preset script in models/. Extra arguments go to both engine benchmarks (`--save` writes
 # engine/benches/RESULTS.md and engine/benches/LOAD_TIME.md; a bare word keeps only the models
-# whose name contains it).
+# whose name contains it). Finally it bundles the plugin (target/bundled/Ressort.clap and
+# Ressort.vst3) and builds ressort-standalone, both release builds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -17,3 +18,7 @@ mkdir -p out
 "$ressort" bench models/string-1000.mdl
 cargo bench -p ressort-engine --bench reference_models --locked -- "$@"
 cargo bench -p ressort-engine --bench load_time --locked -- "$@"
+# The plugin: CLAP and VST3 bundles in target/bundled/, and the standalone application.
+cargo xtask bundle ressort-plugin --release
+cargo build --release --locked -p ressort-plugin --bin ressort-standalone
+ls -l target/bundled/
