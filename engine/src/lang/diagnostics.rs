@@ -129,6 +129,50 @@ pub enum DiagnosticCode {
 }
 
 impl DiagnosticCode {
+    /// Every category, in declaration order (errors first, then warnings).
+    pub const ALL: [DiagnosticCode; 40] = [
+        DiagnosticCode::InvalidUtf8,
+        DiagnosticCode::UnterminatedBracket,
+        DiagnosticCode::NestedBracket,
+        DiagnosticCode::StrayBracket,
+        DiagnosticCode::UnterminatedQuote,
+        DiagnosticCode::InvalidNumber,
+        DiagnosticCode::NonFiniteNumber,
+        DiagnosticCode::WrongArgumentCount,
+        DiagnosticCode::BadLabel,
+        DiagnosticCode::BadChannelLabel,
+        DiagnosticCode::NonIntegerSize,
+        DiagnosticCode::InvalidSize,
+        DiagnosticCode::TooLarge,
+        DiagnosticCode::ExpressionSyntax,
+        DiagnosticCode::ExpressionTooDeep,
+        DiagnosticCode::WrongArity,
+        DiagnosticCode::FunctionWithoutCall,
+        DiagnosticCode::VectorSize,
+        DiagnosticCode::ExpectedEndpoint,
+        DiagnosticCode::InvalidDirectiveArgument,
+        DiagnosticCode::UnknownGenerator,
+        DiagnosticCode::UnknownGeneratorKey,
+        DiagnosticCode::MissingGeneratorKey,
+        DiagnosticCode::InvalidGeneratorValue,
+        DiagnosticCode::DuplicateLabel,
+        DiagnosticCode::UndefinedName,
+        DiagnosticCode::NotAParameter,
+        DiagnosticCode::UndefinedElement,
+        DiagnosticCode::NotAPoint,
+        DiagnosticCode::NotAMacro,
+        DiagnosticCode::WrongCoordinateCount,
+        DiagnosticCode::BareMacroReference,
+        DiagnosticCode::UnknownKeyword,
+        DiagnosticCode::ConflictingDirective,
+        DiagnosticCode::PlusSeparator,
+        DiagnosticCode::IgnoredCommandLike,
+        DiagnosticCode::UnknownDirective,
+        DiagnosticCode::ScopeNotOpen,
+        DiagnosticCode::ScopeAlreadyOpen,
+        DiagnosticCode::TooManyDiagnostics,
+    ];
+
     /// Whether this category is an error or a warning (spec §3.12 f).
     pub fn severity(self) -> Severity {
         use DiagnosticCode::*;
