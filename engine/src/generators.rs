@@ -121,6 +121,9 @@ pub struct Generated {
     pub links: Vec<String>,
     /// Node pairs of each link (indices into `nodes`).
     pub pairs: Vec<(usize, usize)>,
+    /// The parameters the generator declared, in order: `<name>_M`, `<name>_K`, `<name>_Z`,
+    /// `<name>_Zo`, and `<name>_Ks` for the stiff string.
+    pub params: Vec<String>,
 }
 
 impl Generated {
@@ -138,6 +141,10 @@ impl Generated {
 /// The largest structure a generator builds, in nodes.
 pub const MAX_GENERATED_NODES: usize = 1 << 20;
 
+/// The most links a generator builds. Without it a 3-D lattice with a wide neighbour span and
+/// diagonals could ask for billions of links from a handful of nodes.
+pub const MAX_GENERATED_LINKS: usize = 1 << 22;
+
 /// Why a generator refused.
 #[derive(Clone, Debug, PartialEq)]
 pub enum GeneratorError {
@@ -145,6 +152,8 @@ pub enum GeneratorError {
     TooSmall { what: &'static str, min: usize },
     /// More than [`MAX_GENERATED_NODES`] nodes.
     TooLarge { nodes: usize },
+    /// More than [`MAX_GENERATED_LINKS`] links.
+    TooManyLinks { links: usize },
     /// A non-finite or non-positive value where one is required.
     InvalidValue { what: &'static str, value: f64 },
 }
@@ -156,6 +165,10 @@ impl std::fmt::Display for GeneratorError {
             GeneratorError::TooLarge { nodes } => write!(
                 f,
                 "{nodes} nodes is more than the limit of {MAX_GENERATED_NODES}"
+            ),
+            GeneratorError::TooManyLinks { links } => write!(
+                f,
+                "{links} links is more than the limit of {MAX_GENERATED_LINKS}"
             ),
             GeneratorError::InvalidValue { what, value } => write!(f, "invalid {what}: {value}"),
         }
@@ -207,6 +220,117 @@ fn check_size(nodes: usize) -> Result<(), GeneratorError> {
     }
 }
 
+/// The lattice neighbour offsets in the positive half-space (first non-zero component > 0), so
+/// that each pair is linked once. Offsets longer than an axis can never link two nodes, so the
+/// span is clamped per axis: the loop stays within the lattice's own extent whatever the span.
+fn lattice_offsets(size: [usize; 3], span: usize, diagonals: bool) -> Vec<[i64; 3]> {
+    let reach = size.map(|n| span.min(n.saturating_sub(1)) as i64);
+    let mut offsets = Vec::new();
+    for dx in -reach[0]..=reach[0] {
+        for dy in -reach[1]..=reach[1] {
+            for dz in -reach[2]..=reach[2] {
+                let d = [dx, dy, dz];
+                let first_nonzero = d.iter().find(|v| **v != 0);
+                if first_nonzero.is_none_or(|v| *v < 0) {
+                    continue;
+                }
+                let nonzero = d.iter().filter(|v| **v != 0).count();
+                if diagonals || nonzero == 1 {
+                    offsets.push(d);
+                }
+            }
+        }
+    }
+    offsets
+}
+
+impl Topology {
+    /// The number of nodes (fixed ones included) and links the topology generates, computed
+    /// without building anything. Fails as [`generate`] would on a size below the shape's
+    /// minimum or a structure above [`MAX_GENERATED_NODES`] or [`MAX_GENERATED_LINKS`], so a
+    /// caller can refuse an absurd request before anything is allocated.
+    pub fn counts(&self) -> Result<(usize, usize), GeneratorError> {
+        let (nodes, links) = match self {
+            Topology::String { nodes: n } | Topology::StiffString { nodes: n } => {
+                check_min(*n, 1, "the number of moving nodes")?;
+                let points = n.saturating_add(2);
+                check_size(points)?;
+                let links = if matches!(self, Topology::StiffString { .. }) {
+                    2 * n + 3
+                } else {
+                    n + 1
+                };
+                (points, links)
+            }
+            Topology::Chain { nodes: n } => {
+                check_min(*n, 2, "the number of chain nodes")?;
+                check_size(*n)?;
+                (*n, n - 1)
+            }
+            Topology::Mesh { length, width, .. } => {
+                let (l, w) = (*length, *width);
+                check_min(l, 2, "the mesh length")?;
+                check_min(w, 2, "the mesh width")?;
+                check_size(l.saturating_mul(w))?;
+                (l * w, l * (w - 1) + (l - 1) * w)
+            }
+            Topology::Triangle { size, .. } => {
+                let s = *size;
+                check_min(s, 2, "the triangle size")?;
+                check_size(s.saturating_mul(s.saturating_add(1)) / 2)?;
+                (s * (s + 1) / 2, 3 * s * (s - 1) / 2)
+            }
+            Topology::Hexagon { rings, .. } => {
+                let s = *rings;
+                check_min(s, 1, "the number of hexagon rings")?;
+                let points = s
+                    .saturating_mul(s.saturating_add(1))
+                    .saturating_mul(3)
+                    .saturating_add(1);
+                check_size(points)?;
+                (points, 9 * s * s + 3 * s)
+            }
+            Topology::Ring { nodes: n, .. } => {
+                check_min(*n, 3, "the number of ring nodes")?;
+                check_size(*n)?;
+                (*n, *n)
+            }
+            Topology::Lattice {
+                size,
+                span,
+                diagonals,
+                ..
+            } => {
+                for n in size {
+                    check_min(*n, 1, "each lattice size")?;
+                }
+                check_min(*span, 1, "the neighbour span")?;
+                let points = size.iter().fold(1usize, |p, n| p.saturating_mul(*n));
+                check_size(points)?;
+                let links = lattice_offsets(*size, *span, *diagonals)
+                    .iter()
+                    .map(|d| {
+                        (0..3).fold(1usize, |p, a| {
+                            p.saturating_mul(size[a] - d[a].unsigned_abs() as usize)
+                        })
+                    })
+                    .fold(0usize, usize::saturating_add);
+                (points, links)
+            }
+            Topology::Polyline { points, closed } => {
+                let n = points.len();
+                check_min(n, 2, "the number of polyline points")?;
+                check_size(n)?;
+                (n, if *closed && n > 2 { n } else { n - 1 })
+            }
+        };
+        if links > MAX_GENERATED_LINKS {
+            return Err(GeneratorError::TooManyLinks { links });
+        }
+        Ok((nodes, links))
+    }
+}
+
 /// Expands `topology` into `builder` with the values of `g`. Returns the labels of what it
 /// created, for addressing nodes afterwards.
 pub fn generate(
@@ -231,8 +355,31 @@ pub fn generate(
             value: g.m,
         });
     }
+    if let Some(&v) = g.first.iter().chain(&g.last).find(|v| !v.is_finite()) {
+        return Err(GeneratorError::InvalidValue {
+            what: "box coordinate",
+            value: v,
+        });
+    }
     let (nodes, links, stiff_links) = layout(g, topology)?;
-    Ok(emit(builder, g, topology, nodes, links, stiff_links))
+    // A finite box can still overflow (a box from -1e308 to 1e308, a huge ring radius).
+    if let Some(&v) = nodes.iter().flat_map(|n| &n.pos).find(|v| !v.is_finite()) {
+        return Err(GeneratorError::InvalidValue {
+            what: "node position",
+            value: v,
+        });
+    }
+    let out = labels(&g.name, topology, &nodes, &links, &stiff_links);
+    emit(builder, g, &nodes, &out, links.len());
+    Ok(out)
+}
+
+/// The labels and link pairs [`generate`] would create for a structure named `name`, without
+/// building anything. Labels depend only on the name and the topology (not on the values or
+/// the box), so a parser can learn them before it evaluates anything.
+pub fn plan(name: &str, topology: &Topology) -> Result<Generated, GeneratorError> {
+    let (nodes, links, stiff_links) = layout(&Generator::new(name), topology)?;
+    Ok(labels(name, topology, &nodes, &links, &stiff_links))
 }
 
 /// Node list and link pairs of a topology. Stiffness links (stiff string) come separately.
@@ -241,13 +388,12 @@ fn layout(
     g: &Generator,
     topology: &Topology,
 ) -> Result<(Vec<Node>, Vec<(usize, usize)>, Vec<(usize, usize)>), GeneratorError> {
-    let mut nodes = Vec::new();
-    let mut links = Vec::new();
+    let (num_nodes, num_links) = topology.counts()?;
+    let mut nodes = Vec::with_capacity(num_nodes);
+    let mut links = Vec::with_capacity(num_links);
     let mut stiff = Vec::new();
     match topology {
         Topology::String { nodes: n } | Topology::StiffString { nodes: n } => {
-            check_min(*n, 1, "the number of moving nodes")?;
-            check_size(n + 2)?;
             // Grounds at the box ends, n nodes equally spaced (n + 1 intervals).
             let t = |k: usize| k as f64 / (n + 1) as f64;
             nodes.push(Node {
@@ -277,8 +423,6 @@ fn layout(
             }
         }
         Topology::Chain { nodes: n } => {
-            check_min(*n, 2, "the number of chain nodes")?;
-            check_size(*n)?;
             for k in 0..*n {
                 let tk = frac(k, *n);
                 nodes.push(Node {
@@ -295,9 +439,6 @@ fn layout(
             fixed,
         } => {
             let (l, w) = (*length, *width);
-            check_min(l, 2, "the mesh length")?;
-            check_min(w, 2, "the mesh width")?;
-            check_size(l.saturating_mul(w))?;
             for i in 0..l {
                 for j in 0..w {
                     let border = i == 0 || i == l - 1 || j == 0 || j == w - 1;
@@ -328,8 +469,6 @@ fn layout(
         }
         Topology::Triangle { size, fixed } => {
             let s = *size;
-            check_min(s, 2, "the triangle size")?;
-            check_size(s.saturating_mul(s + 1) / 2)?;
             let spacing_x = (g.last[0] - g.first[0]) / (s - 1) as f64;
             let mut index = vec![vec![0usize; s]; s];
             for j in 0..s {
@@ -370,8 +509,6 @@ fn layout(
         }
         Topology::Hexagon { rings, fixed } => {
             let s = *rings as i64;
-            check_min(*rings, 1, "the number of hexagon rings")?;
-            check_size(1 + 3 * rings.saturating_mul(rings + 1))?;
             let spacing = (g.last[0] - g.first[0]) / (2 * s) as f64;
             let centre = [
                 (g.first[0] + g.last[0]) / 2.0,
@@ -384,19 +521,26 @@ fn layout(
                     spacing * r as f64 * 3f64.sqrt() / 2.0,
                 )
             };
-            // Axial coordinates, centre then ring by ring by increasing polar angle from 0.
+            // Axial coordinates, centre then ring by ring by increasing polar angle from 0 of
+            // the regular geometry (unit spacing, so the order and hence the labels do not
+            // depend on the box, even a mirrored or flat one).
             let mut axial: Vec<(i64, i64)> = vec![(0, 0)];
             for ring in 1..=s {
-                let mut cells: Vec<(i64, i64)> = Vec::new();
+                // Distance ≤ ring means r ∈ [max(−ring, −q−ring), min(ring, ring−q)]; the
+                // distance is exactly `ring` on the two ends of that range, and all along it
+                // for |q| = ring: 6·ring cells.
+                let mut cells: Vec<(i64, i64)> = Vec::with_capacity(6 * ring as usize);
                 for q in -ring..=ring {
-                    for r in -ring..=ring {
-                        if q.abs().max(r.abs()).max((q + r).abs()) == ring {
-                            cells.push((q, r));
-                        }
+                    let (lo, hi) = ((-ring).max(-q - ring), ring.min(ring - q));
+                    if q.abs() == ring {
+                        cells.extend((lo..=hi).map(|r| (q, r)));
+                    } else {
+                        cells.push((q, lo));
+                        cells.push((q, hi));
                     }
                 }
                 let angle = |&(q, r): &(i64, i64)| {
-                    let (x, y) = geometry(q, r);
+                    let (x, y) = (q as f64 + r as f64 / 2.0, r as f64 * 3f64.sqrt() / 2.0);
                     y.atan2(x).rem_euclid(2.0 * std::f64::consts::PI)
                 };
                 cells.sort_by(|a, b| angle(a).total_cmp(&angle(b)));
@@ -431,8 +575,6 @@ fn layout(
             }
         }
         Topology::Ring { nodes: n, radius } => {
-            check_min(*n, 3, "the number of ring nodes")?;
-            check_size(*n)?;
             if !radius.is_finite() {
                 return Err(GeneratorError::InvalidValue {
                     what: "radius",
@@ -460,11 +602,6 @@ fn layout(
             fixed,
         } => {
             let [nx, ny, nz] = *size;
-            for n in size {
-                check_min(*n, 1, "each lattice size")?;
-            }
-            check_min(*span, 1, "the neighbour span")?;
-            check_size(nx.saturating_mul(ny).saturating_mul(nz))?;
             let id = |x: usize, y: usize, z: usize| (x * ny + y) * nz + z;
             for x in 0..nx {
                 for y in 0..ny {
@@ -494,25 +631,7 @@ fn layout(
                     }
                 }
             }
-            // Offsets in the positive half-space (first non-zero component > 0), so that each
-            // pair is linked once.
-            let s = *span as i64;
-            let mut offsets = Vec::new();
-            for dx in -s..=s {
-                for dy in -s..=s {
-                    for dz in -s..=s {
-                        let d = [dx, dy, dz];
-                        let first_nonzero = d.iter().find(|v| **v != 0);
-                        if first_nonzero.is_none_or(|v| *v < 0) {
-                            continue;
-                        }
-                        let nonzero = d.iter().filter(|v| **v != 0).count();
-                        if *diagonals || nonzero == 1 {
-                            offsets.push(d);
-                        }
-                    }
-                }
-            }
+            let offsets = lattice_offsets(*size, *span, *diagonals);
             for x in 0..nx as i64 {
                 for y in 0..ny as i64 {
                     for z in 0..nz as i64 {
@@ -533,8 +652,6 @@ fn layout(
             }
         }
         Topology::Polyline { points, closed } => {
-            check_min(points.len(), 2, "the number of polyline points")?;
-            check_size(points.len())?;
             if let Some(&(x, y)) = points
                 .iter()
                 .find(|(x, y)| !x.is_finite() || !y.is_finite())
@@ -574,33 +691,45 @@ fn layout(
     Ok((nodes, links, stiff))
 }
 
-fn emit(
-    b: &mut ModelBuilder,
-    g: &Generator,
+/// The labels of a laid-out structure (spec §4 naming).
+fn labels(
+    name: &str,
     topology: &Topology,
-    nodes: Vec<Node>,
-    links: Vec<(usize, usize)>,
-    stiff: Vec<(usize, usize)>,
+    nodes: &[Node],
+    links: &[(usize, usize)],
+    stiff: &[(usize, usize)],
 ) -> Generated {
-    let p = |suffix: &str| format!("{}_{suffix}", g.name);
-    b.param(&p("M"), g.m)
-        .param(&p("K"), g.k)
-        .param(&p("Z"), g.z)
-        .param(&p("Zo"), g.zo);
+    let p = |suffix: &str| format!("{name}_{suffix}");
+    let mut params = vec![p("M"), p("K"), p("Z"), p("Zo")];
     if matches!(topology, Topology::StiffString { .. }) {
-        b.param(&p("Ks"), g.ks);
+        params.push(p("Ks"));
     }
-    let mut out = Generated::default();
-    for node in &nodes {
-        let label = p(&node.suffix);
+    let pairs: Vec<(usize, usize)> = links.iter().chain(stiff).copied().collect();
+    Generated {
+        nodes: nodes.iter().map(|n| p(&n.suffix)).collect(),
+        fixed: nodes.iter().map(|n| n.fixed).collect(),
+        links: (0..pairs.len()).map(|r| p(&format!("r{r}"))).collect(),
+        pairs,
+        params,
+    }
+}
+
+/// Declares the parameters and appends the elements: nodes in order, then the (K, Z) links,
+/// then the undamped stiffness links (the pairs from index `num_damped` on).
+fn emit(b: &mut ModelBuilder, g: &Generator, nodes: &[Node], out: &Generated, num_damped: usize) {
+    let p = |suffix: &str| format!("{}_{suffix}", g.name);
+    for (param, value) in out.params.iter().zip([g.m, g.k, g.z, g.zo, g.ks]) {
+        b.param(param, value);
+    }
+    for (node, label) in nodes.iter().zip(&out.nodes) {
         let pos = Vector::Xyz(node.pos.map(Expr::Num));
         if node.fixed {
-            b.ground(&label, pos);
+            b.ground(label, pos);
         } else if g.zo == 0.0 {
-            b.mass(&label, Expr::param(&p("M")), pos, 0.0);
+            b.mass(label, Expr::param(&p("M")), pos, 0.0);
         } else {
             b.osc(
-                &label,
+                label,
                 Expr::param(&p("M")),
                 0.0,
                 Expr::param(&p("Zo")),
@@ -608,29 +737,19 @@ fn emit(
                 0.0,
             );
         }
-        out.nodes.push(label);
-        out.fixed.push(node.fixed);
     }
-    let all = links
-        .iter()
-        .map(|l| (l, false))
-        .chain(stiff.iter().map(|l| (l, true)));
-    for (r, (&(a, bb), ks)) in all.enumerate() {
-        let label = p(&format!("r{r}"));
-        let (k, z) = if ks {
+    for (r, (&(a, bb), label)) in out.pairs.iter().zip(&out.links).enumerate() {
+        let (k, z) = if r >= num_damped {
             (Expr::param(&p("Ks")), Expr::Num(0.0))
         } else {
             (Expr::param(&p("K")), Expr::param(&p("Z")))
         };
         b.spring_damper(
-            &label,
+            label,
             Endpoint::label(&out.nodes[a]),
             Endpoint::label(&out.nodes[bb]),
             k,
             z,
         );
-        out.links.push(label);
-        out.pairs.push((a, bb));
     }
-    out
 }

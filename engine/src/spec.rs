@@ -739,4 +739,9 @@ impl ModelBuilder {
     pub fn build(&self) -> ModelSpec {
         self.spec.clone()
     }
+
+    /// The finished spec, without copying it.
+    pub fn finish(self) -> ModelSpec {
+        self.spec
+    }
 }

@@ -464,3 +464,147 @@ fn generated_structures_equal_their_macros() {
         }
     }
 }
+
+/// `Topology::counts` and `plan` agree with what `generate` builds, so callers can refuse a
+/// request before anything is allocated.
+#[test]
+fn counts_and_plan_match_generate() {
+    let topologies = vec![
+        Topology::String { nodes: 7 },
+        Topology::StiffString { nodes: 7 },
+        Topology::Chain { nodes: 7 },
+        Topology::Mesh {
+            length: 4,
+            width: 3,
+            fixed: Fixed::Corners,
+        },
+        Topology::Triangle {
+            size: 5,
+            fixed: Fixed::Borders,
+        },
+        Topology::Hexagon {
+            rings: 4,
+            fixed: Fixed::None,
+        },
+        Topology::Ring {
+            nodes: 9,
+            radius: 2.0,
+        },
+        Topology::Lattice {
+            size: [3, 4, 2],
+            span: 2,
+            diagonals: true,
+            fixed: LatticeFixed::None,
+        },
+        Topology::Lattice {
+            size: [3, 1, 5],
+            span: 9,
+            diagonals: false,
+            fixed: LatticeFixed::Centre,
+        },
+        Topology::Polyline {
+            points: vec![(0.0, 0.0), (1.0, 0.0), (0.5, 1.0)],
+            closed: true,
+        },
+    ];
+    for t in topologies {
+        let (out, spec) = gen(t.clone());
+        assert_eq!(
+            t.counts().unwrap(),
+            (out.nodes.len(), out.links.len()),
+            "{t:?}"
+        );
+        assert_eq!(
+            ressort_engine::generators::plan("t", &t).unwrap(),
+            out,
+            "{t:?}"
+        );
+        assert_eq!(spec.params.len(), out.params.len());
+        for (p, name) in spec.params.iter().zip(&out.params) {
+            assert_eq!(&p.name, name);
+        }
+    }
+}
+
+#[test]
+fn absurd_requests_fail_fast() {
+    use std::time::Instant;
+    let start = Instant::now();
+    // A wide span is clamped to the lattice's extent; too many links is refused up front.
+    let t = Topology::Lattice {
+        size: [1 << 20, 1, 1],
+        span: usize::MAX,
+        diagonals: true,
+        fixed: LatticeFixed::None,
+    };
+    assert!(matches!(
+        t.counts(),
+        Err(GeneratorError::TooManyLinks { .. })
+    ));
+    let t = Topology::Lattice {
+        size: [100, 100, 100],
+        span: 3,
+        diagonals: true,
+        fixed: LatticeFixed::None,
+    };
+    assert!(matches!(
+        t.counts(),
+        Err(GeneratorError::TooManyLinks { .. })
+    ));
+    for t in [
+        Topology::String { nodes: usize::MAX },
+        Topology::Hexagon {
+            rings: usize::MAX,
+            fixed: Fixed::None,
+        },
+        Topology::Triangle {
+            size: usize::MAX,
+            fixed: Fixed::None,
+        },
+        Topology::Lattice {
+            size: [usize::MAX, usize::MAX, 2],
+            span: 1,
+            diagonals: false,
+            fixed: LatticeFixed::None,
+        },
+    ] {
+        assert!(
+            matches!(t.counts(), Err(GeneratorError::TooLarge { .. })),
+            "{t:?}"
+        );
+    }
+    assert!(start.elapsed().as_secs() < 5, "{:?}", start.elapsed());
+    // Positions that overflow are refused.
+    let mut g = Generator::new("x");
+    g.first = [-1e308, 0.0, 0.0];
+    g.last = [1e308, 0.0, 0.0];
+    let mut b = ModelBuilder::new();
+    let t = Topology::Hexagon {
+        rings: 2,
+        fixed: Fixed::None,
+    };
+    assert!(matches!(
+        generate(&mut b, &g, &t),
+        Err(GeneratorError::InvalidValue { .. })
+    ));
+}
+
+/// Hexagon labels follow the regular geometry, whatever the box: a mirrored or flat box gives
+/// the same node order (spec §4.6).
+#[test]
+fn hexagon_order_does_not_depend_on_the_box() {
+    let t = Topology::Hexagon {
+        rings: 3,
+        fixed: Fixed::None,
+    };
+    let run = |first: [f64; 3], last: [f64; 3]| {
+        let mut g = Generator::new("h");
+        g.first = first;
+        g.last = last;
+        let mut b = ModelBuilder::new();
+        generate(&mut b, &g, &t).unwrap()
+    };
+    let normal = run([0.0, 0.0, 0.0], [1.0, 1.0, 0.0]);
+    assert_eq!(run([1.0, 1.0, 0.0], [0.0, 0.0, 0.0]), normal);
+    assert_eq!(run([0.5, 0.5, 0.0], [0.5, 0.5, 0.0]), normal);
+}

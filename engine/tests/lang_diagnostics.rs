@@ -342,6 +342,289 @@ fn conflicting_directive() {
     assert_eq!(p.spec.unwrap().sample_rate_mode, SampleRateMode::Raw);
 }
 
+// ---- `~generate` (spec §4) -------------------------------------------------------------------
+
+/// The 1-based column of the first `needle` in `line`.
+fn col(line: &str, needle: &str) -> u32 {
+    line.find(needle)
+        .unwrap_or_else(|| panic!("{needle} in {line}")) as u32
+        + 1
+}
+
+/// `line` (after the prelude) has exactly one diagnostic, of `code`, at `needle`.
+fn gen_error(line: &str, code: C, needle: &str) -> Diagnostic {
+    after_prelude(line, code, col(line, needle))
+}
+
+#[test]
+fn generate_is_clean_and_known() {
+    let p = parse(&with_prelude(
+        "~generate string g nodes=3 M=1 K=K Z=0.001\n@out1 posOutput @g_m1",
+    ));
+    assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
+}
+
+#[test]
+fn unknown_generator() {
+    let line = "~generate trangle g nodes=3 M=1 K=1 Z=0";
+    let d = gen_error(line, C::UnknownGenerator, "trangle");
+    assert!(d.expected.unwrap().contains("hexagon"));
+    let line = "~generate String g nodes=3 M=1 K=1 Z=0";
+    let d = gen_error(line, C::UnknownGenerator, "String");
+    assert!(d.message.contains("did you mean `string`"), "{d}");
+    // A macro keyword that is no generator, and a bracket in the kind slot.
+    gen_error(
+        "~generate closedMesh g size=3,3 M=1 K=1 Z=0",
+        C::UnknownGenerator,
+        "closedMesh",
+    );
+    gen_error(
+        "~generate [mesh] g size=3,3 M=1 K=1 Z=0",
+        C::UnknownGenerator,
+        "[mesh]",
+    );
+}
+
+#[test]
+fn unknown_generator_key() {
+    let line = "~generate string g nodes=3 M=1 K=1 Z=0 span=2";
+    let d = gen_error(line, C::UnknownGeneratorKey, "span");
+    assert!(d.message.contains("lattice"), "{d}");
+    assert!(d.expected.unwrap().contains("nodes, M, K, Z, Zo, from, to"));
+    let line = "~generate string g nodes=3 M=1 K=1 Z=0 zo=1e-4";
+    let d = gen_error(line, C::UnknownGeneratorKey, "zo");
+    assert!(d.message.contains("did you mean `Zo`"), "{d}");
+    gen_error(
+        "~generate ring g nodes=5 M=1 K=1 Z=0 from=0,0,0",
+        C::UnknownGeneratorKey,
+        "from",
+    );
+    gen_error(
+        "~generate mesh g size=3,3 M=1 K=1 Ks=1 Z=0",
+        C::UnknownGeneratorKey,
+        "Ks",
+    );
+}
+
+#[test]
+fn missing_generator_key() {
+    let line = "~generate mesh g size=3,4 M=1 Z=0";
+    let d = gen_error(line, C::MissingGeneratorKey, "mesh");
+    assert!(d.message.contains("`K=…`"), "{d}");
+    assert!(d
+        .expected
+        .unwrap()
+        .starts_with("~generate mesh NAME size=L,W"));
+    let d = gen_error(
+        "~generate stiffString g M=1 K=1 Z=0",
+        C::MissingGeneratorKey,
+        "stiffString",
+    );
+    assert!(d.message.contains("`nodes=N` and `Ks=…`"), "{d}");
+    // A key written with a bad value is reported once, not as missing too.
+    gen_error(
+        "~generate chain g nodes=3 M= K=1 Z=0",
+        C::InvalidGeneratorValue,
+        "M=",
+    );
+}
+
+#[test]
+fn invalid_generator_value() {
+    let line = "~generate mesh g size=3,4 M=1 K=1 Z=0 fixed=sides";
+    let d = gen_error(line, C::InvalidGeneratorValue, "sides");
+    assert_eq!(d.found.as_deref(), Some("sides"));
+    gen_error(
+        "~generate triangle g size=3 M=1 K=1 Z=0 fixed=centre",
+        C::InvalidGeneratorValue,
+        "centre",
+    );
+    gen_error(
+        "~generate mesh g size=3 M=1 K=1 Z=0",
+        C::InvalidGeneratorValue,
+        "3 ",
+    );
+    gen_error(
+        "~generate lattice g size=3,3 M=1 K=1 Z=0",
+        C::InvalidGeneratorValue,
+        "3,3",
+    );
+    gen_error(
+        "~generate mesh g size=3,4 M=1 K=1 Z=0 from=0,0",
+        C::InvalidGeneratorValue,
+        "0,0",
+    );
+    gen_error(
+        "~generate lattice g size=3,3,3 M=1 K=1 Z=0 diagonals=yes",
+        C::InvalidGeneratorValue,
+        "yes",
+    );
+    gen_error(
+        "~generate polyline g points=0,0;1 M=1 K=1 Z=0",
+        C::InvalidGeneratorValue,
+        "1 M",
+    );
+    // Values evaluated when the script is read: finite, M > 0, from control parameters above.
+    gen_error(
+        "~generate chain g nodes=3 M=0 K=1 Z=0",
+        C::InvalidGeneratorValue,
+        "0 K",
+    );
+    gen_error(
+        "~generate chain g nodes=3 M=1 K=1 Z=[sqrt(-1)]",
+        C::InvalidGeneratorValue,
+        "sqrt",
+    );
+    let p = parse("@a audioParam @in1\n~generate chain g nodes=3 M=1 K=a Z=0\n");
+    let d = find(&p, C::InvalidGeneratorValue, 2, 33);
+    assert!(d.message.contains("audio-rate"), "{d}");
+    let p = parse("~generate chain g nodes=3 M=1 K=later Z=0\n@later param 1\n");
+    let d = find(&p, C::InvalidGeneratorValue, 1, 33);
+    assert!(d.message.contains("declared after"), "{d}");
+    assert_eq!(p.diagnostics.len(), 1);
+    // Names that are no parameter at all are the expression's own errors.
+    gen_error(
+        "~generate chain g nodes=3 M=1 K=nothing Z=0",
+        C::UndefinedName,
+        "nothing",
+    );
+    gen_error(
+        "~generate chain g nodes=3 M=1 K=m Z=0",
+        C::NotAParameter,
+        "m Z",
+    );
+    // Geometry is literal.
+    gen_error(
+        "~generate mesh g size=3,4 M=1 K=1 Z=0 to=1,K,0",
+        C::InvalidNumber,
+        "K,0",
+    );
+    gen_error(
+        "~generate ring g nodes=5 M=1 K=1 Z=0 radius=1e999",
+        C::NonFiniteNumber,
+        "1e999",
+    );
+}
+
+#[test]
+fn generator_directive_arguments() {
+    gen_error("~generate", C::InvalidDirectiveArgument, "~generate");
+    gen_error("~generate mesh", C::InvalidDirectiveArgument, "mesh");
+    let line = "~generate mesh 1g size=3,3 M=1 K=1 Z=0";
+    gen_error(line, C::InvalidDirectiveArgument, "1g");
+    let line = "~generate mesh size=3,3 M=1 K=1 Z=0";
+    let d = gen_error(line, C::InvalidDirectiveArgument, "size");
+    assert!(d.message.contains("name comes before"), "{d}");
+    gen_error(
+        "~generate mesh g size=3,3 M=1 K=1 Z=0 junk",
+        C::InvalidDirectiveArgument,
+        "junk",
+    );
+    gen_error(
+        "~generate mesh g size=3,3 M=1 K=1 Z=0 =2",
+        C::InvalidDirectiveArgument,
+        "=2",
+    );
+    let line = "~generate mesh g size=3,3 M=1 K=1 Z=0 K=2";
+    after_prelude(line, C::InvalidDirectiveArgument, 39);
+}
+
+#[test]
+fn generator_sizes() {
+    gen_error(
+        "~generate mesh g size=3.5,4 M=1 K=1 Z=0",
+        C::NonIntegerSize,
+        "3.5",
+    );
+    gen_error(
+        "~generate mesh g size=3,K M=1 K=1 Z=0",
+        C::NonIntegerSize,
+        "K M",
+    );
+    gen_error(
+        "~generate string g nodes=0 M=1 K=1 Z=0",
+        C::InvalidSize,
+        "0 M",
+    );
+    gen_error(
+        "~generate ring g nodes=2 M=1 K=1 Z=0",
+        C::InvalidSize,
+        "2 M",
+    );
+    gen_error(
+        "~generate mesh g size=4,1 M=1 K=1 Z=0",
+        C::InvalidSize,
+        "1 M",
+    );
+    gen_error(
+        "~generate polyline g points=1,1 M=1 K=1 Z=0",
+        C::InvalidSize,
+        "1,1",
+    );
+    gen_error(
+        "~generate mesh g size=3000,4000 M=1 K=1 Z=0",
+        C::TooLarge,
+        "3000",
+    );
+    let d = gen_error(
+        "~generate lattice g size=30,40,50 M=1 K=1 Z=0 span=4 diagonals=on",
+        C::TooLarge,
+        "30",
+    );
+    assert!(d.message.contains("links"), "{d}");
+    gen_error(
+        "~generate chain g nodes=99999999999999999999999 M=1 K=1 Z=0",
+        C::TooLarge,
+        "999",
+    );
+    // The per-script budget counts every directive.
+    let max = ressort_engine::lang::MAX_GENERATED_ELEMENTS;
+    assert!(parse("~generate mesh a size=290,290 M=1 K=1 Z=0")
+        .diagnostics
+        .is_empty());
+    let p = parse(
+        "~generate mesh a size=250,250 M=1 K=1 Z=0\n~generate mesh b size=200,200 M=1 K=1 Z=0\n",
+    );
+    let d = find(&p, C::TooLarge, 2, 23);
+    let left = max - 250 * 250 - 2 * 250 * 249;
+    assert!(d
+        .expected
+        .unwrap()
+        .contains(&format!("the {left} generated elements left")));
+    assert_eq!(p.diagnostics.len(), 1);
+}
+
+#[test]
+fn generated_label_clashes() {
+    // A label declared before the directive: reported at the generator's name.
+    let d = only(
+        "@g_m0 mass 1 0 0\n~generate chain g nodes=3 M=1 K=1 Z=0\n",
+        C::DuplicateLabel,
+        2,
+        17,
+    );
+    assert!(
+        d.message.contains("`@g_m0`") && d.message.contains("line 1 column 1"),
+        "{d}"
+    );
+    // A command after the directive: reported on the command, naming the directive.
+    let d = only(
+        "~generate chain g nodes=3 M=1 K=1 Z=0\n@g_K param 2\n",
+        C::DuplicateLabel,
+        2,
+        1,
+    );
+    assert!(d.message.contains("`~generate` at line 1 column 17"), "{d}");
+    // Two generators with the same name: one error, with the count of the others.
+    let d = only(
+        "~generate chain g nodes=3 M=1 K=1 Z=0\n~generate ring g nodes=3 M=1 K=1 Z=0\n",
+        C::DuplicateLabel,
+        2,
+        16,
+    );
+    assert!(d.message.contains("more of its labels clash"), "{d}");
+}
+
 // ---- warnings ---------------------------------------------------------------------------------
 
 #[test]

@@ -22,9 +22,9 @@ fn check(parsed: &Parsed) {
 /// Characters the grammar cares about, so random text hits interesting paths. Each byte
 /// picks a character (one random draw per character keeps the unoptimised RNG cheap).
 fn scripty() -> impl Strategy<Value = String> {
-    const ALPHABET: [char; 28] = [
+    const ALPHABET: [char; 32] = [
         '@', '~', '[', ']', '(', ')', '\'', '#', '+', '-', '*', '/', '.', 'e', ' ', '\t', '\n',
-        '\r', ',', '1', '0', '9', 'm', 'K', 'é', '\u{feff}', 'x', '_',
+        '\r', ',', '1', '0', '9', 'm', 'K', 'é', '\u{feff}', 'x', '_', 'g', 'G', 'h', '=',
     ];
     proptest::collection::vec(any::<u8>(), 0..200).prop_map(|bytes| {
         let s: String = bytes
@@ -37,6 +37,14 @@ fn scripty() -> impl Strategy<Value = String> {
         // Sprinkle whole keywords in too.
         s.replace('m', " mass ")
             .replace('K', " string 10 1 1 1 0 0\n@s ")
+            // `~generate` directives (spec §4), whole and in pieces.
+            .replace('g', "\n~generate ")
+            .replace('G', " string s nodes=3 M=1 K=0.1 Z=0 ")
+            .replace(
+                'h',
+                " mesh q size=3,2 fixed=corners hexagon ring lattice polyline points=0,0;1,1 \
+                 span=2 diagonals=on ",
+            )
     })
 }
 
@@ -149,6 +157,27 @@ fn adversarial_shapes() {
         "@K param 1e308\n@m mass [K*K*K] 0 0\n".to_string(),
         "@m mass [1/0] [sqrt(-1)] [log(0)]\n".to_string(),
         "\r\r\n\n\r".repeat(mb / 4),
+        "~generate lattice l size=1048576,1,1 span=999999999 diagonals=on M=1 K=1 Z=0\n"
+            .to_string(),
+        "~generate lattice l size=100,100,100 span=100 diagonals=on M=1 K=1 Z=0\n".to_string(),
+        "~generate hexagon h size=99999999 M=1 K=1 Z=0\n".to_string(),
+        "~generate triangle t size=18446744073709551615 M=1 K=1 Z=0\n".to_string(),
+        format!(
+            "~generate polyline p points={}1,1 M=1 K=1 Z=0\n",
+            "0,0;".repeat(300_000)
+        ),
+        (0..100_000)
+            .map(|i| format!("~generate string s{i} nodes=1 M=1 K=1 Z=0\n@o{i} mass 1 0 0\n"))
+            .collect(),
+        "~generate mesh m size=290,290 M=1 K=1 Z=0 fixed=borders\n@out1 posOutput @m_m1_1\n"
+            .to_string(),
+        "~generate hexagon h size=3 M=1 K=1 Z=0 from=-1e308,0,0 to=1e308,0,0\n".to_string(),
+        "@P param 1e308\n~generate string s nodes=3 M=[P*10] K=[P-P] Z=0\n".to_string(),
+        format!(
+            "~generate string s nodes=3 M=1 K=[{}1{}] Z=0\n",
+            "(".repeat(mb),
+            ")".repeat(mb)
+        ),
         "\u{feff}@m mass 1 0 0\n".to_string(),
     ];
     for (i, text) in cases.iter().enumerate() {

@@ -402,6 +402,8 @@ fn script() -> impl Strategy<Value = String> {
             "[@me 0.2 0.3]",
             "[@s (K - 1)]",
             "@in1",
+            "@gs_m1",
+            "@gs_g0",
         ])
     };
     let buf = || select(vec!["a", "b", "c"]);
@@ -427,18 +429,33 @@ fn script() -> impl Strategy<Value = String> {
         buf().prop_map(|b| format!("~begin {b}")),
         buf().prop_map(|b| format!("~end {b}")),
         Just("~samplerate raw".to_string()),
+        (val(), val()).prop_map(|(a, b)| format!("~generate string G nodes=3 M=1 K={a} Z={b}")),
+        (val(), select(vec!["none", "corners", "borders"])).prop_map(|(a, f)| format!(
+            "~generate mesh G size=3,2 M=1 K={a} Z=0 Zo=1e-4 fixed={f} from=0,0,0 to=2,1,0"
+        )),
+        val().prop_map(|a| format!("~generate triangle G size=3 M={a} K=0.1 Z=0 fixed=corners")),
+        val().prop_map(|a| format!("~generate hexagon G size=1 M=1 K=0.1 Z={a}")),
+        val().prop_map(|a| format!("~generate ring G nodes=4 radius=0.5 M=1 K={a} Z=0")),
+        val().prop_map(|a| format!(
+            "~generate lattice G size=2,2,2 span=1 diagonals=on M=1 K={a} Z=0 fixed=zmax"
+        )),
+        val().prop_map(|a| format!("~generate polyline G points=0,0;1,0;1,1 M=1 K={a} Z=0")),
+        val().prop_map(|a| format!("~generate stiffString G nodes=3 M=1 K=0.1 Ks={a} Z=0")),
         Just("# a comment".to_string()),
     ];
     proptest::collection::vec(line, 0..16).prop_map(|lines| {
         let mut text = String::from(
             "@K param 0.1\n@m mass 1 0 0\n@n ground 0\n@s string 10 1 K 0 0 0\n\
-             @me cornerMesh 4 5 1 K 0 0 0\n@in1 posInput 0\n",
+             @me cornerMesh 4 5 1 K 0 0 0\n@in1 posInput 0\n\
+             ~generate string gs nodes=3 M=1 K=K Z=0\n",
         );
         for (i, l) in lines.iter().enumerate() {
             let l = if let Some(rest) = l.strip_prefix("in:") {
                 format!("@in{}{rest}", i + 2)
             } else if let Some(rest) = l.strip_prefix("out:") {
                 format!("@out{}{rest}", i + 1)
+            } else if l.starts_with("~generate") {
+                l.replacen(" G ", &format!(" g{i} "), 1)
             } else if l.starts_with(['~', '#']) {
                 l.clone()
             } else {
@@ -474,16 +491,23 @@ fn script_generator_reaches_valid_scripts() {
     use proptest::test_runner::TestRunner;
     let mut runner = TestRunner::deterministic();
     let mut ok = 0;
+    let mut with_generators = 0;
     for _ in 0..500 {
         let Ok(tree) = script().new_tree(&mut runner) else {
             continue;
         };
-        if parse(&tree.current())
-            .spec
-            .is_some_and(|s| s.elements.len() > 6)
-        {
+        let text = tree.current();
+        if parse(&text).spec.is_some_and(|s| s.elements.len() > 6) {
             ok += 1;
+            // A `~generate` line besides the prelude's.
+            if text.matches("~generate").count() > 1 {
+                with_generators += 1;
+            }
         }
     }
     assert!(ok >= 50, "only {ok} of 500 generated scripts are valid");
+    assert!(
+        with_generators >= 20,
+        "only {with_generators} valid scripts with `~generate` lines"
+    );
 }

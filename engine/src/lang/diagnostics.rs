@@ -53,12 +53,13 @@ pub enum DiagnosticCode {
     /// An input or output label that is not `@inN`/`@outN` with a positive decimal N, e.g.
     /// `@in3x` (spec §3.4, §3.12 a).
     BadChannelLabel,
-    /// A macro size that is not an integer literal, e.g. `40.5`, `40abc` or a parameter name
-    /// (spec §2.7, §3.12 a).
+    /// A macro or generator size that is not an integer literal, e.g. `40.5`, `40abc` or a
+    /// parameter name (spec §2.7, §3.12 a, §4).
     NonIntegerSize,
-    /// A macro size below 2 (spec §2.7).
+    /// A macro size below 2 (spec §2.7), or a generator size below the shape's minimum (§4).
     InvalidSize,
-    /// A macro with more than 1 048 576 nodes, or a size that overflows.
+    /// A macro with more than 1 048 576 nodes, a size that overflows, too many open scopes, or
+    /// generators beyond their node, link or per-script element limits.
     TooLarge,
     /// An expression that does not follow the grammar of spec §3.5.
     ExpressionSyntax,
@@ -72,11 +73,24 @@ pub enum DiagnosticCode {
     VectorSize,
     /// Something other than `@label` or `[@macro …]` in an endpoint or target slot (spec §3.4).
     ExpectedEndpoint,
-    /// A directive with a missing, extra or invalid argument (spec §3.11).
+    /// A directive with a missing, extra or invalid argument (spec §3.11), including a
+    /// `~generate` name that is not an identifier, an argument that is not `key=value`, and a
+    /// key given twice.
     InvalidDirectiveArgument,
+    /// `~generate` of a generator kind that does not exist (spec §4).
+    UnknownGenerator,
+    /// A `~generate` key that the generator does not take, e.g. `span=` on a mesh.
+    UnknownGeneratorKey,
+    /// A `~generate` directive without one of its generator's required keys.
+    MissingGeneratorKey,
+    /// A `~generate` value of the wrong form (`fixed=sides`, `size=4` for a mesh), or a value
+    /// that cannot be evaluated when the script is read (an audio-rate parameter, a parameter
+    /// declared later, NaN, M ≤ 0).
+    InvalidGeneratorValue,
 
     // ---- semantic errors ------------------------------------------------------------------
-    /// A label used twice; parameters and elements share one namespace (spec §3.4).
+    /// A label used twice; parameters and elements share one namespace (spec §3.4). Labels
+    /// created by `~generate` count too.
     DuplicateLabel,
     /// An expression names no declared parameter, or calls an unknown function such as `floor`
     /// (spec §3.5, §3.12 c).
@@ -115,6 +129,50 @@ pub enum DiagnosticCode {
 }
 
 impl DiagnosticCode {
+    /// Every category, in declaration order (errors first, then warnings).
+    pub const ALL: [DiagnosticCode; 40] = [
+        DiagnosticCode::InvalidUtf8,
+        DiagnosticCode::UnterminatedBracket,
+        DiagnosticCode::NestedBracket,
+        DiagnosticCode::StrayBracket,
+        DiagnosticCode::UnterminatedQuote,
+        DiagnosticCode::InvalidNumber,
+        DiagnosticCode::NonFiniteNumber,
+        DiagnosticCode::WrongArgumentCount,
+        DiagnosticCode::BadLabel,
+        DiagnosticCode::BadChannelLabel,
+        DiagnosticCode::NonIntegerSize,
+        DiagnosticCode::InvalidSize,
+        DiagnosticCode::TooLarge,
+        DiagnosticCode::ExpressionSyntax,
+        DiagnosticCode::ExpressionTooDeep,
+        DiagnosticCode::WrongArity,
+        DiagnosticCode::FunctionWithoutCall,
+        DiagnosticCode::VectorSize,
+        DiagnosticCode::ExpectedEndpoint,
+        DiagnosticCode::InvalidDirectiveArgument,
+        DiagnosticCode::UnknownGenerator,
+        DiagnosticCode::UnknownGeneratorKey,
+        DiagnosticCode::MissingGeneratorKey,
+        DiagnosticCode::InvalidGeneratorValue,
+        DiagnosticCode::DuplicateLabel,
+        DiagnosticCode::UndefinedName,
+        DiagnosticCode::NotAParameter,
+        DiagnosticCode::UndefinedElement,
+        DiagnosticCode::NotAPoint,
+        DiagnosticCode::NotAMacro,
+        DiagnosticCode::WrongCoordinateCount,
+        DiagnosticCode::BareMacroReference,
+        DiagnosticCode::UnknownKeyword,
+        DiagnosticCode::ConflictingDirective,
+        DiagnosticCode::PlusSeparator,
+        DiagnosticCode::IgnoredCommandLike,
+        DiagnosticCode::UnknownDirective,
+        DiagnosticCode::ScopeNotOpen,
+        DiagnosticCode::ScopeAlreadyOpen,
+        DiagnosticCode::TooManyDiagnostics,
+    ];
+
     /// Whether this category is an error or a warning (spec §3.12 f).
     pub fn severity(self) -> Severity {
         use DiagnosticCode::*;
@@ -149,6 +207,10 @@ impl DiagnosticCode {
             VectorSize => "vector-size",
             ExpectedEndpoint => "expected-endpoint",
             InvalidDirectiveArgument => "invalid-directive-argument",
+            UnknownGenerator => "unknown-generator",
+            UnknownGeneratorKey => "unknown-generator-key",
+            MissingGeneratorKey => "missing-generator-key",
+            InvalidGeneratorValue => "invalid-generator-value",
             DuplicateLabel => "duplicate-label",
             UndefinedName => "undefined-name",
             NotAParameter => "not-a-parameter",

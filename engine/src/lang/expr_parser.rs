@@ -18,7 +18,7 @@
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::lexer::is_blank;
 use crate::expr::{BinOp, Expr, Func};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// The deepest nesting (parentheses, calls, unary operators) and the deepest expression tree the
 /// front end accepts. Below the compiler's own limit of 256 (`compile::MAX_EXPR_DEPTH`).
@@ -62,9 +62,56 @@ pub(crate) struct Symbol {
     pub kind: SymKind,
     pub line: u32,
     pub col: u32,
+    /// Declared by a `~generate` directive (at `line:col`) rather than by a command.
+    pub generated: bool,
 }
 
-pub(crate) type Symbols = HashMap<String, Symbol>;
+/// Every label of a script (spec §3.4), for name resolution and endpoint checks.
+#[derive(Debug, Default)]
+pub(crate) struct Symbols {
+    map: HashMap<String, Symbol>,
+    /// Names of `~generate` directives that have an error: their labels are not known, so any
+    /// `<name>_…` that is not declared otherwise resolves to [`SymKind::Unknown`] and
+    /// references to it are not reported again (no cascades).
+    broken_generators: HashSet<String>,
+}
+
+impl Symbols {
+    pub(crate) fn new() -> Symbols {
+        Symbols::default()
+    }
+
+    /// The symbol named `name`: a declared label, or an unknown one under a broken generator.
+    pub(crate) fn get(&self, name: &str) -> Option<Symbol> {
+        if let Some(s) = self.map.get(name) {
+            return Some(*s);
+        }
+        let under_broken = name
+            .char_indices()
+            .filter(|&(_, c)| c == '_')
+            .any(|(i, _)| self.broken_generators.contains(name.get(..i).unwrap_or("")));
+        under_broken.then_some(Symbol {
+            kind: SymKind::Unknown,
+            line: 0,
+            col: 0,
+            generated: true,
+        })
+    }
+
+    /// The symbol declared as `name`, ignoring broken generators.
+    pub(crate) fn declared(&self, name: &str) -> Option<Symbol> {
+        self.map.get(name).copied()
+    }
+
+    pub(crate) fn insert(&mut self, name: String, symbol: Symbol) {
+        self.map.insert(name, symbol);
+    }
+
+    /// Records a `~generate` directive named `name` whose labels could not be worked out.
+    pub(crate) fn insert_broken_generator(&mut self, name: String) {
+        self.broken_generators.insert(name);
+    }
+}
 
 /// True for identifiers `[A-Za-z_][A-Za-z0-9_]*` (spec §3.4).
 pub(crate) fn is_identifier(s: &str) -> bool {
@@ -601,6 +648,7 @@ mod tests {
                     kind: SymKind::Param,
                     line: 1,
                     col: 1,
+                    generated: false,
                 },
             );
         }

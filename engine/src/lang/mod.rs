@@ -15,17 +15,33 @@
 //!
 //! The language is a superset of MIMS4Max (§3.12 a): `#` comments anywhere, scientific
 //! notation, expressions with the functions of §3.5, legacy `massG`, two-parameter `spring` and
-//! `nlSpring`, `~samplerate raw|scaled`, nested and overlapping buffer scopes (§3.10) and legacy
-//! trailing buffer tags (§6.4).
+//! `nlSpring`, `~samplerate raw|scaled`, nested and overlapping buffer scopes (§3.10), legacy
+//! trailing buffer tags (§6.4), and the `~generate` directive, which expands a topology
+//! generator of §4 inline into explicit, addressable elements:
+//!
+//! ```
+//! use ressort_engine::lang::parse;
+//! let parsed = parse(
+//!     "~generate triangle tri size=10 M=1 K=0.3 Z=1e-4 fixed=corners from=0,0,0 to=1,1,0\n\
+//!      @out1 posOutput @tri_m3_2\n",
+//! );
+//! let spec = parsed.spec.unwrap();
+//! assert!(spec.param("tri_K").is_some());
+//! assert!(spec.element("tri_m3_2").is_some());
+//! ```
+//!
+//! See `docs/LANGUAGE.md` for the whole language.
 
 mod diagnostics;
 mod expr_parser;
+mod generate;
 mod lexer;
 mod parser;
 mod printer;
 
 pub use diagnostics::{Diagnostic, DiagnosticCode, Severity, MAX_DIAGNOSTICS};
 pub use expr_parser::MAX_NESTING;
+pub use generate::MAX_GENERATED_ELEMENTS;
 pub use parser::{parse, parse_bytes, MAX_MACRO_NODES, MAX_OPEN_SCOPES};
 pub use printer::print;
 

@@ -11,6 +11,7 @@ use super::expr_parser::{
     is_identifier, parse_expression, parse_number_literal, ExprContext, NumberError, SymKind,
     Symbol, Symbols,
 };
+use super::generate::{self, GenRequest, Read, MAX_GENERATED_ELEMENTS};
 use super::lexer::{is_blank, split_items, split_lines, tokenize, TokKind, Token};
 use super::Parsed;
 use crate::expr::{Expr, Func};
@@ -145,7 +146,17 @@ struct Item {
     /// A command line with a lexical error: only its label token is kept, for pass 1.
     broken: bool,
     tokens: Vec<Token>,
+    /// A `~generate` directive read in pass 1 and expanded in pass 2.
+    generator: Option<Box<GenRequest>>,
+    /// The name of a `~generate` line with a lexical error: its labels are unknown.
+    broken_generator: Option<String>,
 }
+
+fn is_generate(item: &Item) -> bool {
+    item.directive && item.tokens.first().is_some_and(|t| t.text == GENERATE)
+}
+
+const GENERATE: [char; 9] = ['~', 'g', 'e', 'n', 'e', 'r', 'a', 't', 'e'];
 
 /// Parses script text (spec §3). See [`Parsed`].
 pub fn parse(text: &str) -> Parsed {
@@ -232,6 +243,8 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
                         directive,
                         broken: false,
                         tokens,
+                        generator: None,
+                        broken_generator: None,
                     }),
                     None if !directive => {
                         // Keep the label known so references to it do not cascade: the line
@@ -254,9 +267,30 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
                                 col: col_of(first),
                                 inner_col: col_of(first),
                             }],
+                            generator: None,
+                            broken_generator: None,
                         });
                     }
-                    None => {}
+                    None => {
+                        // A `~generate` line with a lexical error: its labels are unknown, so
+                        // references to them must not cascade.
+                        let text: String = chars.iter().skip(first).collect();
+                        let words: Vec<&str> = text
+                            .split(is_blank)
+                            .filter(|w| !w.is_empty())
+                            .take(3)
+                            .collect();
+                        if let Some(name) = generate::broken_name(&words) {
+                            items.push(Item {
+                                line,
+                                directive: true,
+                                broken: true,
+                                tokens: Vec::new(),
+                                generator: None,
+                                broken_generator: Some(name),
+                            });
+                        }
+                    }
                 }
             }
             Some('#') => {}
@@ -264,9 +298,26 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
         }
     }
 
-    // Pass 1: labels (spec §3.4).
+    // Pass 1: labels (spec §3.4), including those `~generate` creates (§4).
     let mut symbols = Symbols::new();
-    for item in items.iter().filter(|i| !i.directive) {
+    let mut budget = MAX_GENERATED_ELEMENTS;
+    for item in items.iter_mut() {
+        if item.directive {
+            if let Some(name) = item.broken_generator.take() {
+                symbols.insert_broken_generator(name);
+            } else if is_generate(item) {
+                match generate::read(&item.tokens, item.line, &mut diags, &mut budget) {
+                    Read::Ready(req) => {
+                        if declare_generated(&req, &mut symbols, &mut diags) {
+                            item.generator = Some(req);
+                        }
+                    }
+                    Read::Broken { name: Some(name) } => symbols.insert_broken_generator(name),
+                    Read::Broken { name: None } => {}
+                }
+            }
+            continue;
+        }
         let Some(first) = item.tokens.first() else {
             continue;
         };
@@ -290,18 +341,27 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
             .and_then(|t| shape_of(&t.string()))
             .map(sym_kind)
             .unwrap_or(SymKind::Unknown);
-        match symbols.get(&label) {
+        match symbols.declared(&label) {
             Some(prev) => {
+                let message = if prev.generated {
+                    format!(
+                        "duplicate label `@{label}`: the `~generate` at line {} column {} \
+                         already creates it",
+                        prev.line, prev.col
+                    )
+                } else {
+                    format!(
+                        "duplicate label `@{label}`: already used at line {} column {} \
+                         (parameters and elements share one namespace)",
+                        prev.line, prev.col
+                    )
+                };
                 diags.push(
                     Diagnostic::new(
                         DiagnosticCode::DuplicateLabel,
                         item.line,
                         first.col,
-                        format!(
-                            "duplicate label `@{label}`: already used at line {} column {} \
-                             (parameters and elements share one namespace)",
-                            prev.line, prev.col
-                        ),
+                        message,
                     )
                     .with_label(Some(&label)),
                 );
@@ -313,6 +373,7 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
                         kind,
                         line: item.line,
                         col: first.col,
+                        generated: false,
                     },
                 );
             }
@@ -329,7 +390,11 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
         samplerate: None,
     };
     for item in items.iter().filter(|i| !i.broken) {
-        if item.directive {
+        if let Some(req) = &item.generator {
+            b.generate(req);
+        } else if is_generate(item) {
+            // Reported in pass 1.
+        } else if item.directive {
             b.directive(item);
         } else {
             b.command(item);
@@ -349,6 +414,83 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
         spec: ok.then_some(spec),
         diagnostics: diags.finish(),
     }
+}
+
+/// Declares the labels a `~generate` directive creates (pass 1). A clash with a label declared
+/// earlier is reported once, at the generator's name; the directive is then not expanded.
+/// Returns true when every label was free.
+fn declare_generated(req: &GenRequest, symbols: &mut Symbols, diags: &mut Diags) -> bool {
+    let plan = match crate::generators::plan(&req.name, &req.topology) {
+        Ok(plan) => plan,
+        Err(e) => {
+            // `generate::read` checked the sizes; report anything else rather than panic.
+            diags.push(
+                Diagnostic::new(
+                    DiagnosticCode::InvalidGeneratorValue,
+                    req.line,
+                    req.kind_col,
+                    e.to_string(),
+                )
+                .with_label(Some(&req.name)),
+            );
+            symbols.insert_broken_generator(req.name.clone());
+            return false;
+        }
+    };
+    let labels = plan
+        .params
+        .into_iter()
+        .map(|l| (l, SymKind::Param))
+        .chain(plan.nodes.into_iter().map(|l| (l, SymKind::Point)))
+        .chain(plan.links.into_iter().map(|l| (l, SymKind::Interaction)));
+    let mut first_clash: Option<(String, Symbol)> = None;
+    let mut clashes = 0usize;
+    for (label, kind) in labels {
+        match symbols.declared(&label) {
+            Some(prev) => {
+                clashes += 1;
+                if first_clash.is_none() {
+                    first_clash = Some((label, prev));
+                }
+            }
+            None => symbols.insert(
+                label,
+                Symbol {
+                    kind,
+                    line: req.line,
+                    col: req.name_col,
+                    generated: true,
+                },
+            ),
+        }
+    }
+    let Some((label, prev)) = first_clash else {
+        return true;
+    };
+    let by = if prev.generated {
+        "the `~generate`"
+    } else {
+        "the label"
+    };
+    let more = match clashes {
+        1 => String::new(),
+        n => format!(" ({} more of its labels clash too)", n - 1),
+    };
+    diags.push(
+        Diagnostic::new(
+            DiagnosticCode::DuplicateLabel,
+            req.line,
+            req.name_col,
+            format!(
+                "`~generate {} {}` creates `@{label}`, already used by {by} at line {} column \
+                 {}{more}; choose another generator name",
+                req.keyword, req.name, prev.line, prev.col
+            ),
+        )
+        .with_label(Some(&req.name))
+        .with_found(format!("@{label}")),
+    );
+    false
 }
 
 fn col_of(i: usize) -> u32 {
@@ -444,6 +586,21 @@ impl Builder<'_> {
         i
     }
 
+    /// Expands a `~generate` directive at its place in script order (spec §4): its parameters
+    /// and elements join the spec, its points the open scopes.
+    fn generate(&mut self, req: &GenRequest) {
+        if let Some((params, elements)) = generate::expand(
+            req,
+            self.symbols,
+            &self.spec.params,
+            &self.open,
+            &mut self.diags,
+        ) {
+            self.spec.params.extend(params);
+            self.spec.elements.extend(elements);
+        }
+    }
+
     /// `~begin`, `~end`, `~samplerate` (spec §3.10, §3.11).
     fn directive(&mut self, item: &Item) {
         let Some(first) = item.tokens.first() else {
@@ -465,7 +622,7 @@ impl Builder<'_> {
                         first.col,
                         format!("unknown directive `~{name}` ignored"),
                     )
-                    .with_expected("~begin, ~end or ~samplerate")
+                    .with_expected("~begin, ~end, ~samplerate or ~generate")
                     .with_found(format!("~{name}")),
                 );
                 return;

@@ -1,0 +1,105 @@
+//! The examples of the language guide, `docs/LANGUAGE.md`, are real: every ```mims block parses
+//! without a diagnostic, every ```mims-error block has an error and every ```mims-warning block
+//! only warnings; the ```text block that follows an error or warning example is exactly what
+//! the parser reports (in `ressort check`'s `model.mdl:LINE:COL: …` form); and every diagnostic
+//! code is documented.
+
+use ressort_engine::lang::{parse, print};
+use ressort_engine::DiagnosticCode;
+
+const GUIDE: &str = include_str!("../../docs/LANGUAGE.md");
+
+/// A fenced block: its tag, its text and the line of the opening fence (1-based).
+struct Block {
+    tag: String,
+    text: String,
+    line: usize,
+}
+
+fn blocks() -> Vec<Block> {
+    let mut out = Vec::new();
+    let mut current: Option<Block> = None;
+    for (i, line) in GUIDE.lines().enumerate() {
+        match (&mut current, line.strip_prefix("```")) {
+            (None, Some(tag)) => {
+                current = Some(Block {
+                    tag: tag.trim().to_string(),
+                    text: String::new(),
+                    line: i + 1,
+                })
+            }
+            (Some(_), Some("")) => out.extend(current.take()),
+            (Some(b), _) => {
+                b.text.push_str(line);
+                b.text.push('\n');
+            }
+            (None, None) => {}
+        }
+    }
+    assert!(current.is_none(), "unclosed fence in LANGUAGE.md");
+    out
+}
+
+#[test]
+fn valid_examples_parse_cleanly_and_round_trip() {
+    let mut count = 0;
+    for b in blocks().iter().filter(|b| b.tag == "mims") {
+        let p = parse(&b.text);
+        assert!(
+            p.diagnostics.is_empty(),
+            "LANGUAGE.md line {}:\n{}\n{:#?}",
+            b.line,
+            b.text,
+            p.diagnostics
+        );
+        let spec = p.spec.unwrap();
+        assert_eq!(parse(&print(&spec)).spec, Some(spec));
+        count += 1;
+    }
+    assert!(count >= 30, "only {count} examples");
+}
+
+#[test]
+fn error_and_warning_examples_report_what_the_guide_shows() {
+    let all = blocks();
+    let mut checked = 0;
+    for (i, b) in all.iter().enumerate() {
+        let errors = match b.tag.as_str() {
+            "mims-error" => true,
+            "mims-warning" => false,
+            _ => continue,
+        };
+        let p = parse(&b.text);
+        let where_ = format!("LANGUAGE.md line {}:\n{}", b.line, b.text);
+        if errors {
+            assert!(p.errors().next().is_some(), "{where_}: no error");
+        } else {
+            assert!(p.spec.is_some(), "{where_}: has an error");
+            assert!(p.warnings().next().is_some(), "{where_}: no warning");
+        }
+        let shown = all
+            .get(i + 1)
+            .filter(|n| n.tag == "text")
+            .unwrap_or_else(|| panic!("{where_}: no ```text block with the output after it"));
+        let reported: Vec<String> = p
+            .diagnostics
+            .iter()
+            .map(|d| format!("model.mdl:{d}"))
+            .collect();
+        let shown: Vec<&str> = shown.text.lines().collect();
+        assert_eq!(reported, shown, "{where_}");
+        checked += 1;
+    }
+    assert!(checked >= 35, "only {checked} diagnostic examples");
+}
+
+#[test]
+fn every_diagnostic_code_is_documented() {
+    for code in DiagnosticCode::ALL {
+        let heading = format!("**`{}`**", code.name());
+        assert!(
+            GUIDE.contains(&heading),
+            "LANGUAGE.md does not document {heading}"
+        );
+    }
+}
