@@ -39,7 +39,7 @@ pub use info::{InputUse, ModelInfo, OutputUse, PointInfo, PointKind};
 pub use lang::{parse, parse_bytes, print, Diagnostic, DiagnosticCode, Parsed, Severity};
 pub use motion::{MotionLayout, MotionStore, NamedBuffer};
 pub use spec::{
-    Element, ElementKind, Endpoint, Law, MacroKind, MacroSpec, ModelBuilder, ModelSpec, ParamDecl,
-    ParamKind, SampleRateMode, ScaleClass, Span, Vector,
+    Element, ElementKind, Endpoint, HostSpec, Law, MacroKind, MacroRange, MacroSpec, ModelBuilder,
+    ModelSpec, ParamDecl, ParamKind, Route, RouteSource, SampleRateMode, ScaleClass, Span, Vector,
 };
 pub use stability::{MassStability, StabilityReport, StabilityWarning};

@@ -432,6 +432,80 @@ pub struct ModelSpec {
     pub elements: Vec<Element>,
     /// Named motion buffers, in order of first opening.
     pub buffers: Vec<String>,
+    /// How a host plays the model (`~pitch`, `~key`, `~note`, `~route`, `~macro`). The
+    /// engine ignores it.
+    pub host: HostSpec,
+}
+
+/// A host channel a model input can be routed to (`~route inK SOURCE`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RouteSource {
+    MainLeft,
+    MainRight,
+    SidechainLeft,
+    SidechainRight,
+    /// Fed by nothing but MIDI strikes.
+    None,
+}
+
+impl RouteSource {
+    /// The script names: `main_left`, `main_right`, `sidechain_left`, `sidechain_right`,
+    /// `none`.
+    pub const NAMES: [(&'static str, RouteSource); 5] = [
+        ("main_left", RouteSource::MainLeft),
+        ("main_right", RouteSource::MainRight),
+        ("sidechain_left", RouteSource::SidechainLeft),
+        ("sidechain_right", RouteSource::SidechainRight),
+        ("none", RouteSource::None),
+    ];
+
+    pub fn name(self) -> &'static str {
+        RouteSource::NAMES
+            .iter()
+            .find(|(_, s)| *s == self)
+            .map(|(n, _)| *n)
+            .unwrap_or("none")
+    }
+
+    pub fn from_name(name: &str) -> Option<RouteSource> {
+        RouteSource::NAMES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, s)| *s)
+    }
+}
+
+/// `~route inK SOURCE`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Route {
+    /// 1-based model input channel.
+    pub input: u32,
+    pub source: RouteSource,
+}
+
+/// `~macro NAME MIN MAX`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MacroRange {
+    pub name: String,
+    pub min: f64,
+    pub max: f64,
+}
+
+/// How a host plays the model. Every field is optional; a host uses its defaults.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct HostSpec {
+    /// `~pitch HZ`: the model's pitch at its reference key, in Hz.
+    pub pitch_hz: Option<f64>,
+    /// `~key NOTE`: the MIDI key at which the model sounds as written (default 60).
+    pub key: Option<f64>,
+    /// `~note inK [FORCE]`: the input (1-based) that MIDI notes strike, and the force of a
+    /// full-velocity note.
+    pub note_input: Option<u32>,
+    pub note_force: Option<f64>,
+    /// `~route` lines, in script order.
+    pub routes: Vec<Route>,
+    /// `~macro` lines, in script order.
+    pub macro_ranges: Vec<MacroRange>,
 }
 
 impl ModelSpec {

@@ -353,6 +353,7 @@ fn spec() -> impl Strategy<Value = ModelSpec> {
                     .take(nbuf)
                     .map(|s| s.to_string())
                     .collect(),
+                host: Default::default(),
             }
         })
 }
@@ -510,4 +511,22 @@ fn script_generator_reaches_valid_scripts() {
         with_generators >= 20,
         "only {with_generators} valid scripts with `~generate` lines"
     );
+}
+
+/// The host directives survive printing: parse(print(parse(x))) == parse(x).
+#[test]
+fn host_directives_round_trip() {
+    let text = "@K param 0.1\n@m osc 1 K 0.001 0 0\n@in1 frcInput @m\n@in2 frcInput @m\n\
+                @out1 posOutput @m\n~pitch 261.625\n~key 60.5\n~note in2 -0.05\n\
+                ~route in1 sidechain_right\n~route in2 none\n~macro K 0.05 2e-1\n";
+    let first = ressort_engine::parse(text).spec.expect("parses");
+    assert_eq!(first.host.pitch_hz, Some(261.625));
+    assert_eq!(first.host.note_input, Some(2));
+    assert_eq!(first.host.routes.len(), 2);
+    let printed = ressort_engine::print(&first);
+    let second = ressort_engine::parse(&printed)
+        .spec
+        .expect("printed text parses");
+    assert_eq!(first.host, second.host, "{printed}");
+    assert_eq!(first, second);
 }

@@ -1,7 +1,7 @@
 //! What a script tells the plugin beyond the physics: input routing, the MIDI note target,
 //! the reference pitch and key, and macro ranges.
 
-use ressort_engine::ModelSpec;
+use ressort_engine::{ModelSpec, RouteSource};
 
 /// A host audio channel that can feed a model input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,9 +79,47 @@ impl Default for HostSettings {
     }
 }
 
+impl From<RouteSource> for InputSource {
+    fn from(r: RouteSource) -> InputSource {
+        match r {
+            RouteSource::MainLeft => InputSource::MainLeft,
+            RouteSource::MainRight => InputSource::MainRight,
+            RouteSource::SidechainLeft => InputSource::SidechainLeft,
+            RouteSource::SidechainRight => InputSource::SidechainRight,
+            RouteSource::None => InputSource::Silent,
+        }
+    }
+}
+
 impl HostSettings {
-    /// Reads the settings of a parsed model.
-    pub fn from_spec(_spec: &ModelSpec) -> Result<HostSettings, Vec<String>> {
-        Ok(HostSettings::default())
+    /// Reads the host directives of a parsed model (`~pitch`, `~key`, `~note`, `~route`,
+    /// `~macro`; see docs/LANGUAGE.md §12.3).
+    pub fn from_spec(spec: &ModelSpec) -> Result<HostSettings, Vec<String>> {
+        let h = &spec.host;
+        let defaults = HostSettings::default();
+        let mut routing: Vec<Option<InputSource>> = Vec::new();
+        for r in &h.routes {
+            let i = r.input as usize - 1;
+            if routing.len() <= i {
+                routing.resize(i + 1, None);
+            }
+            routing[i] = Some(r.source.into());
+        }
+        Ok(HostSettings {
+            routing,
+            note_input: h.note_input.map(|k| k - 1),
+            note_force: h.note_force.unwrap_or(defaults.note_force),
+            reference_pitch_hz: h.pitch_hz,
+            reference_key: h.key.unwrap_or(defaults.reference_key),
+            macro_ranges: h
+                .macro_ranges
+                .iter()
+                .map(|m| MacroRange {
+                    name: m.name.clone(),
+                    min: m.min,
+                    max: m.max,
+                })
+                .collect(),
+        })
     }
 }

@@ -343,14 +343,15 @@ impl Ressort {
                 InputRole::AudioParam => 1.0,
                 InputRole::Unused => 0.0,
             };
+            let rest = model.rest[k];
             let dst = &mut model.inputs[k * len..(k + 1) * len];
             match source.and_then(InputSource::channel) {
                 Some(c) if gain != 0.0 => {
                     for (d, s) in dst.iter_mut().zip(&host_in[c][..len]) {
-                        *d = s * gain;
+                        *d = rest + s * gain;
                     }
                 }
-                _ => dst.fill(0.0),
+                _ => dst.fill(rest),
             }
         }
     }

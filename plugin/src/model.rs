@@ -169,6 +169,9 @@ pub struct Prepared {
     pub roles: Vec<InputRole>,
     /// The host channel feeding each model input, when the script chose one.
     pub routing: Vec<Option<InputSource>>,
+    /// The declared position of each position input's avatar (0 for other inputs): a
+    /// `posInput` receives rest + signal × Position gain.
+    pub rest: Vec<f64>,
     /// The model input a MIDI note strikes (0-based), if it exists.
     pub note_input: Option<usize>,
     pub macros: Vec<Option<MacroBinding>>,
@@ -249,13 +252,38 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
             None => InputRole::Unused,
         })
         .collect();
+    // Avatars rest at their declared position: a silent input holds them there.
+    let rest: Vec<f64> = info
+        .inputs
+        .iter()
+        .map(|uses| match uses.first() {
+            Some(InputUse::Position(label)) => (0..info.num_points)
+                .find(|&i| info.point_label(i) == *label)
+                .map(|i| engine.positions()[i])
+                .unwrap_or(0.0),
+            _ => 0.0,
+        })
+        .collect();
+    if let Some(k) = settings.note_input {
+        if roles.get(k as usize) != Some(&InputRole::Force) {
+            let line = text
+                .lines()
+                .position(|l| l.trim_start().starts_with("~note"))
+                .map(|i| i + 1)
+                .unwrap_or(1);
+            return Err(Rejected(vec![format!(
+                "{line}:1: error: `~note in{}`: in{} is not a force input (frcInput) of this model",
+                k + 1,
+                k + 1
+            )]));
+        }
+    }
     let routing = (0..roles.len())
         .map(|i| settings.routing.get(i).copied().flatten())
         .collect();
     let note_input = settings
         .note_input
         .map(|i| i as usize)
-        .filter(|&i| roles.get(i) == Some(&InputRole::Force))
         .or_else(|| roles.iter().position(|r| *r == InputRole::Force));
 
     let mut settings = settings;
@@ -274,6 +302,7 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
         num_outputs,
         roles,
         routing,
+        rest,
         note_input,
         macros,
         envelope,

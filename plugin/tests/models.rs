@@ -193,3 +193,36 @@ fn the_plugin_ships_every_script_in_models() {
     ids.sort();
     assert_eq!(files, ids);
 }
+
+/// Host directives reach the plugin: routing, note input and force, pitch, key and macro
+/// ranges; a `~note` on an input that is not a force input is an error at its line.
+#[test]
+fn host_directives_configure_the_plugin() {
+    let text = "@K param 0.1\n@o osc 1 K 0.001 0 0\n@in1 frcInput @o\n@in2 frcInput @o\n\
+                @in3 posInput 0.5\n@c contact @in3 @o 0.01 0 0\n@out1 posOutput @o\n\
+                ~pitch 440\n~key 69\n~note in2 -0.1\n~route in1 sidechain_right\n~macro K 0.05 0.2\n";
+    let p = prepare("t", text, 48_000.0).unwrap();
+    assert_eq!(p.note_input, Some(1));
+    assert_eq!(p.settings.note_force, -0.1);
+    assert_eq!(p.settings.reference_pitch_hz, Some(440.0));
+    assert_eq!(p.settings.reference_key, 69.0);
+    assert_eq!(
+        p.routing,
+        vec![
+            Some(ressort_plugin::host::InputSource::SidechainRight),
+            None,
+            None
+        ]
+    );
+    assert_eq!(p.rest, vec![0.0, 0.0, 0.5]);
+    let k = p.macros[0].as_ref().unwrap();
+    assert_eq!((k.min, k.max), (0.05, 0.2));
+
+    let bad = text.replace("~note in2 -0.1", "~note in3");
+    let err = prepare("t", &bad, 48_000.0).unwrap_err();
+    assert!(
+        err.0[0].starts_with("10:1: error: `~note in3`"),
+        "{:?}",
+        err.0
+    );
+}

@@ -16,8 +16,8 @@ use super::lexer::{is_blank, split_items, split_lines, tokenize, TokKind, Token}
 use super::Parsed;
 use crate::expr::{Expr, Func};
 use crate::spec::{
-    Element, ElementKind, Endpoint, Law, MacroKind, MacroSpec, ModelSpec, ParamDecl, ParamKind,
-    SampleRateMode, Span, Vector,
+    Element, ElementKind, Endpoint, Law, MacroKind, MacroRange, MacroSpec, ModelSpec, ParamDecl,
+    ParamKind, Route, RouteSource, SampleRateMode, Span, Vector,
 };
 use std::collections::HashMap;
 
@@ -416,6 +416,18 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
     }
 }
 
+/// The highest model input a host directive may name.
+const MAX_HOST_INPUT: u32 = 64;
+
+fn plural_args(count: &[usize]) -> String {
+    match count {
+        [1] => "one argument".into(),
+        [n] => format!("{n} arguments"),
+        [a, b] => format!("{a} or {b} arguments"),
+        _ => "arguments".into(),
+    }
+}
+
 /// Declares the labels a `~generate` directive creates (pass 1). A clash with a label declared
 /// earlier is reported once, at the generator's name; the directive is then not expanded.
 /// Returns true when every label was free.
@@ -612,6 +624,10 @@ impl Builder<'_> {
             line: item.line,
             label: None,
         };
+        if matches!(name.as_str(), "pitch" | "key" | "note" | "route" | "macro") {
+            self.host_directive(item, &name, first.col, args);
+            return;
+        }
         let expected = match name.as_str() {
             "begin" | "end" => "a buffer name (an identifier)",
             "samplerate" => "`raw` or `scaled`",
@@ -622,7 +638,9 @@ impl Builder<'_> {
                         first.col,
                         format!("unknown directive `~{name}` ignored"),
                     )
-                    .with_expected("~begin, ~end, ~samplerate or ~generate")
+                    .with_expected(
+                        "~begin, ~end, ~samplerate, ~generate, ~pitch, ~key, ~note, ~route or ~macro",
+                    )
                     .with_found(format!("~{name}")),
                 );
                 return;
@@ -739,6 +757,201 @@ impl Builder<'_> {
                     first.col,
                     format!("`~end {value}`: the scope `{value}` is not open"),
                 )),
+            }
+        }
+    }
+
+    /// The host directives: `~pitch HZ`, `~key NOTE`, `~note inK [FORCE]`,
+    /// `~route inK SOURCE`, `~macro NAME MIN MAX`. They tell a host how to play the model;
+    /// the engine ignores them.
+    fn host_directive(&mut self, item: &Item, name: &str, col: u32, args: &[Token]) {
+        let at = At {
+            line: item.line,
+            label: None,
+        };
+        let (expected, count): (&str, &[usize]) = match name {
+            "pitch" => ("a frequency in Hz (a positive number)", &[1]),
+            "key" => ("a MIDI key number, 0 to 127", &[1]),
+            "note" => ("an input (`in1`…) and optionally the force of a full-velocity note", &[1, 2]),
+            "route" => (
+                "an input (`in1`…) and main_left, main_right, sidechain_left, sidechain_right or none",
+                &[2],
+            ),
+            _ => ("a param name, then its minimum and maximum", &[3]),
+        };
+        let bad = |diags: &mut Diags, col: u32, message: String, found: Option<String>| {
+            let mut d = at
+                .diag(DiagnosticCode::InvalidDirectiveArgument, col, message)
+                .with_expected(expected);
+            if let Some(f) = found {
+                d = d.with_found(f);
+            }
+            diags.push(d);
+        };
+        if !count.contains(&args.len()) || args.iter().any(|a| a.kind != TokKind::Bare) {
+            let at_col = args
+                .iter()
+                .find(|a| a.kind != TokKind::Bare)
+                .or(args.get(count.iter().copied().max().unwrap_or(1)))
+                .map(|a| a.col)
+                .unwrap_or(col);
+            bad(
+                &mut self.diags,
+                at_col,
+                format!("`~{name}` takes {}", plural_args(count)),
+                None,
+            );
+            return;
+        }
+        let number =
+            |t: &Token| -> Option<f64> { t.string().parse::<f64>().ok().filter(|v| v.is_finite()) };
+        let input = |t: &Token| -> Option<u32> {
+            let s = t.string();
+            let digits = s.strip_prefix("in")?;
+            if digits.starts_with('0') || digits.is_empty() {
+                return None;
+            }
+            digits
+                .parse::<u32>()
+                .ok()
+                .filter(|&k| k >= 1 && k <= MAX_HOST_INPUT)
+        };
+        let conflict = |diags: &mut Diags, what: &str| {
+            diags.push(at.diag(
+                DiagnosticCode::ConflictingDirective,
+                col,
+                format!("a second `~{name}` for {what}"),
+            ));
+        };
+        let host = &mut self.spec.host;
+        match name {
+            "pitch" => match number(&args[0]).filter(|v| *v > 0.0) {
+                Some(v) if host.pitch_hz.is_none() => host.pitch_hz = Some(v),
+                Some(_) => conflict(&mut self.diags, "the model"),
+                None => bad(
+                    &mut self.diags,
+                    args[0].col,
+                    "the pitch must be a positive number of Hz".into(),
+                    Some(args[0].source()),
+                ),
+            },
+            "key" => match number(&args[0]).filter(|v| (0.0..=127.0).contains(v)) {
+                Some(v) if host.key.is_none() => host.key = Some(v),
+                Some(_) => conflict(&mut self.diags, "the model"),
+                None => bad(
+                    &mut self.diags,
+                    args[0].col,
+                    "the key must be a MIDI key number from 0 to 127".into(),
+                    Some(args[0].source()),
+                ),
+            },
+            "note" => {
+                let Some(k) = input(&args[0]) else {
+                    bad(
+                        &mut self.diags,
+                        args[0].col,
+                        format!("`{}` is not an input", args[0].source()),
+                        Some(args[0].source()),
+                    );
+                    return;
+                };
+                let force = match args.get(1) {
+                    Some(t) => match number(t) {
+                        Some(v) => Some(v),
+                        None => {
+                            bad(
+                                &mut self.diags,
+                                t.col,
+                                "the note force must be a number".into(),
+                                Some(t.source()),
+                            );
+                            return;
+                        }
+                    },
+                    None => None,
+                };
+                if host.note_input.is_some() {
+                    conflict(&mut self.diags, "the model");
+                    return;
+                }
+                host.note_input = Some(k);
+                host.note_force = force;
+            }
+            "route" => {
+                let Some(k) = input(&args[0]) else {
+                    bad(
+                        &mut self.diags,
+                        args[0].col,
+                        format!("`{}` is not an input", args[0].source()),
+                        Some(args[0].source()),
+                    );
+                    return;
+                };
+                let Some(source) = RouteSource::from_name(&args[1].string()) else {
+                    bad(
+                        &mut self.diags,
+                        args[1].col,
+                        format!("unknown input source `{}`", args[1].source()),
+                        Some(args[1].source()),
+                    );
+                    return;
+                };
+                if host.routes.iter().any(|r| r.input == k) {
+                    conflict(&mut self.diags, &format!("in{k}"));
+                    return;
+                }
+                host.routes.push(Route { input: k, source });
+            }
+            _ => {
+                let param = args[0].string();
+                let (Some(min), Some(max)) = (number(&args[1]), number(&args[2])) else {
+                    let t = if number(&args[1]).is_none() {
+                        &args[1]
+                    } else {
+                        &args[2]
+                    };
+                    bad(
+                        &mut self.diags,
+                        t.col,
+                        "the range must be two finite numbers".into(),
+                        Some(t.source()),
+                    );
+                    return;
+                };
+                let is_param = self
+                    .symbols
+                    .get(&param)
+                    .is_some_and(|p| matches!(p.kind, SymKind::Param));
+                if !is_param {
+                    self.diags.push(
+                        at.diag(
+                            DiagnosticCode::UndefinedName,
+                            args[0].col,
+                            format!("`~macro {param}`: no param `{param}`"),
+                        )
+                        .with_expected("the name of a `param`")
+                        .with_found(param),
+                    );
+                    return;
+                }
+                if !(min < max) {
+                    bad(
+                        &mut self.diags,
+                        args[1].col,
+                        format!("the range {min} … {max} is empty"),
+                        None,
+                    );
+                    return;
+                }
+                if host.macro_ranges.iter().any(|r| r.name == param) {
+                    conflict(&mut self.diags, &format!("`{param}`"));
+                    return;
+                }
+                host.macro_ranges.push(MacroRange {
+                    name: param,
+                    min,
+                    max,
+                });
             }
         }
     }

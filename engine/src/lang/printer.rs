@@ -1,7 +1,8 @@
 //! Canonical script text for a [`ModelSpec`] (spec §3), such that
 //! `parse(&print(&spec)).spec == Some(spec)` for every spec the parser can produce.
 //!
-//! Layout: `~samplerate raw` when raw (§3.11); the parameters; then the elements in script
+//! Layout: `~samplerate raw` when raw (§3.11); the parameters; the host directives (`~pitch`,
+//! `~key`, `~note`, `~route`, `~macro`); then the elements in script
 //! order, with `~begin`/`~end` scopes reconstructed so that every element's buffer membership
 //! (and the order of [`ModelSpec::buffers`]) is preserved (§3.10). Legacy forms print
 //! canonically: a two-parameter `spring` prints as `springDamper`, `nlSpring` as `nlSpring2`;
@@ -381,6 +382,35 @@ pub fn print(spec: &ModelSpec) -> String {
                 let _ = writeln!(out, "@{} audioParam @in{input}", p.name);
             }
         }
+    }
+    let h = &spec.host;
+    if let Some(v) = h.pitch_hz {
+        let _ = writeln!(out, "~pitch {}", format_number(v));
+    }
+    if let Some(v) = h.key {
+        let _ = writeln!(out, "~key {}", format_number(v));
+    }
+    if let Some(k) = h.note_input {
+        match h.note_force {
+            Some(f) => {
+                let _ = writeln!(out, "~note in{k} {}", format_number(f));
+            }
+            None => {
+                let _ = writeln!(out, "~note in{k}");
+            }
+        }
+    }
+    for r in &h.routes {
+        let _ = writeln!(out, "~route in{} {}", r.input, r.source.name());
+    }
+    for m in &h.macro_ranges {
+        let _ = writeln!(
+            out,
+            "~macro {} {} {}",
+            m.name,
+            format_number(m.min),
+            format_number(m.max)
+        );
     }
     out.push_str(&body);
     out
