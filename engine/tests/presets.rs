@@ -293,7 +293,11 @@ fn canonical_scripts_equal_the_builder_reference_models() {
         ("mesh-25x20.mdl", reference::mesh_25x20()),
         ("hammer-oscillator.mdl", reference::hammer_oscillator()),
     ] {
-        assert_eq!(preset(file), spec, "{file} differs from the builder model");
+        // Host directives (`~pitch`, `~note`, …) tell the plugin how to play a preset; the
+        // physics must be the builder's.
+        let mut parsed = preset(file);
+        parsed.host = Default::default();
+        assert_eq!(parsed, spec, "{file} differs from the builder model");
     }
 }
 

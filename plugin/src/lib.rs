@@ -31,9 +31,6 @@ use runtime::RuntimeStatus;
 const SWAP_FADE_MS: f64 = 20.0;
 /// Time for the output to fade back in after the guard reset an exploding model.
 const GUARD_FADE_MS: f64 = 50.0;
-/// A post-gain output above this (+24 dBFS) counts as an explosion even before the engine's
-/// own guard sees it.
-const BLAST_LEVEL: f64 = 16.0;
 /// Output and input below this count as silence for the host's sleep decision (−120 dBFS).
 const QUIET_LEVEL: f64 = 1e-6;
 /// Smoothing time constant of the physical controls.
@@ -43,13 +40,6 @@ const GAIN_SMOOTHING_MS: f64 = 5.0;
 /// The Stiffness gain that Damping can never take away through the stability clamp: the
 /// model's own stiffness.
 const KEPT_STIFFNESS_GAIN: f64 = 1.0;
-
-/// What the plugin asks its background thread to do.
-#[derive(Debug, Clone, Copy)]
-pub enum Task {
-    /// Tell the host's log that the guard reset an exploding model.
-    ReportGuard { trips: u32 },
-}
 
 pub struct Ressort {
     params: Arc<RessortParams>,
@@ -251,9 +241,28 @@ impl Ressort {
         );
         let requested_k = 2f64.powf(st) * tuning;
         let requested_z = 2f64.powf(dz);
-        let (gk, gz, clamped) = model
-            .envelope
-            .clamp(requested_k, requested_z, KEPT_STIFFNESS_GAIN);
+        let mut moved = [(&model.envelope, 0.0); NUM_MACROS];
+        let mut n_moved = 0;
+        for (slot, (binding, envs)) in model.macros.iter().zip(&model.macro_envelopes).enumerate() {
+            if let (Some(b), Some((low, high))) = (binding, envs) {
+                let v = b.value_at(self.macros[slot].value);
+                let (env, f) = if v > b.default && b.max > b.default {
+                    (high, (v - b.default) / (b.max - b.default))
+                } else if v < b.default && b.min < b.default {
+                    (low, (b.default - v) / (b.default - b.min))
+                } else {
+                    continue;
+                };
+                moved[n_moved] = (env, f.clamp(0.0, 1.0));
+                n_moved += 1;
+            }
+        }
+        let (gk, gz, clamped) = model.envelope.clamp_moved(
+            requested_k,
+            requested_z,
+            KEPT_STIFFNESS_GAIN,
+            &moved[..n_moved],
+        );
         model.engine.set_class_gain(ScaleClass::Stiffness, gk);
         model.engine.set_class_gain(ScaleClass::Damping, gz);
         for (slot, binding) in model.macros.iter().enumerate() {
@@ -356,25 +365,20 @@ impl Ressort {
         }
     }
 
-    /// The guard reset the model: count it, tell the host, fade back in.
-    fn guard_tripped(&mut self, context: &mut impl ProcessContext<Self>) {
+    /// The guard reset the model: count it, raise the flag, fade back in.
+    fn guard_tripped(&mut self) {
         if let Some(model) = self.current.as_mut() {
             model.engine.reset();
         }
         self.dc.iter_mut().for_each(DcBlocker::reset);
         self.guard_gain = 0.0;
         self.guard_step = 1.0 / (GUARD_FADE_MS * 1e-3 * self.sample_rate).max(1.0);
-        let trips = self
-            .store
-            .runtime
-            .guard_trips
-            .fetch_add(1, Ordering::AcqRel)
-            + 1;
-        self.store
-            .runtime
-            .guard_active
-            .store(true, Ordering::Release);
-        context.execute_background(Task::ReportGuard { trips });
+        // Atomics only: nice-plug 0.4.2's shared background worker exits when it runs a task
+        // of an instance that is gone, and the next instance's destruction then aborts the
+        // host, so the audio thread never queues tasks.
+        let rt = &self.store.runtime;
+        rt.guard_trips.fetch_add(1, Ordering::AcqRel);
+        rt.guard_active.store(true, Ordering::Release);
     }
 }
 
@@ -420,20 +424,11 @@ impl Plugin for Ressort {
     const SAMPLE_ACCURATE_AUTOMATION: bool = true;
 
     type SysExMessage = ();
-    type BackgroundTask = Task;
+    type BackgroundTask = ();
     type Editor = ();
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()
-    }
-
-    fn task_executor(&mut self) -> TaskExecutor<Self> {
-        Box::new(|task| match task {
-            Task::ReportGuard { trips } => nice_log!(
-                "Ressort: the model exploded and was reset (guard trip {trips}); lower Stiffness \
-                 or check the model's stability report"
-            ),
-        })
     }
 
     fn activate(
@@ -594,7 +589,7 @@ impl Plugin for Ressort {
                     l = self.dc[0].process(l);
                     r = self.dc[1].process(r);
                 }
-                if !(l.abs() <= BLAST_LEVEL && r.abs() <= BLAST_LEVEL) {
+                if !(l.is_finite() && r.is_finite()) {
                     tripped = true;
                     l = 0.0;
                     r = 0.0;
@@ -623,7 +618,7 @@ impl Plugin for Ressort {
                 }
             }
             if tripped {
-                self.guard_tripped(context);
+                self.guard_tripped();
             }
             pos += len;
             self.counter += len as u64;

@@ -95,6 +95,9 @@ pub struct LoadLine {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StabilityEnvelope {
     pub lines: Vec<LoadLine>,
+    /// The factor applied to the analysed loads (below 1 when the bound rejected the model
+    /// as written; see [`envelope`]).
+    pub scale: f64,
 }
 
 impl StabilityEnvelope {
@@ -149,7 +152,53 @@ impl StabilityEnvelope {
                 lines.push(l);
             }
         }
-        StabilityEnvelope { lines }
+        StabilityEnvelope { lines, scale: 1.0 }
+    }
+
+    fn scaled(mut self, scale: f64) -> StabilityEnvelope {
+        for l in &mut self.lines {
+            l.k *= scale;
+            l.z *= scale;
+        }
+        self.scale = scale;
+        self
+    }
+
+    /// Clamps like [`StabilityEnvelope::clamp`] while macro slots move parameters: `moved`
+    /// holds, per moved slot, the envelope at the end of its range it moved towards and how
+    /// far (0 … 1, linear in the parameter value). Each limit is interpolated harmonically
+    /// between this envelope's and the moved one's, which bounds the true limit from below
+    /// when loads depend linearly on the parameter; the tightest slot wins.
+    pub fn clamp_moved(
+        &self,
+        gk: f64,
+        gz: f64,
+        k_floor: f64,
+        moved: &[(&StabilityEnvelope, f64)],
+    ) -> (f64, f64, bool) {
+        const TOLERANCE: f64 = 1.0 + 1e-9;
+        let blend = |a: f64, b: f64, f: f64| -> f64 {
+            if !(a.is_finite() && b.is_finite()) {
+                return a.min(b);
+            }
+            let inv = (1.0 - f) / a.max(1e-300) + f / b.max(1e-300);
+            1.0 / inv
+        };
+        let z_limit = moved
+            .iter()
+            .fold(self.max_damping(gk.min(k_floor)), |acc, (e, f)| {
+                acc.min(blend(
+                    self.max_damping(gk.min(k_floor)),
+                    e.max_damping(gk.min(k_floor)),
+                    *f,
+                ))
+            });
+        let z = gz.min(z_limit * TOLERANCE);
+        let k_limit = moved.iter().fold(self.max_stiffness(z), |acc, (e, f)| {
+            acc.min(blend(self.max_stiffness(z), e.max_stiffness(z), *f))
+        });
+        let k = gk.min(k_limit * TOLERANCE);
+        (k, z, k < gk || z < gz)
     }
 }
 
@@ -176,6 +225,9 @@ pub struct Prepared {
     pub note_input: Option<usize>,
     pub macros: Vec<Option<MacroBinding>>,
     pub envelope: StabilityEnvelope,
+    /// Per macro slot: the envelopes with its param at the range's minimum and maximum (the
+    /// others at their declared values).
+    pub macro_envelopes: Vec<Option<(StabilityEnvelope, StabilityEnvelope)>>,
     /// Loads at unit gains: (worst load, label of the worst mass or structure).
     pub worst_load: (f64, String),
 }
@@ -294,6 +346,20 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
     let report = engine.stability();
     let worst_load = worst_load(&report);
     let macros = macro_bindings(&mut engine, &settings);
+    let macro_envelopes = macros
+        .iter()
+        .map(|b| {
+            b.as_ref().map(|b| {
+                let _ = engine.set_param(b.param, b.min);
+                let low = raw_envelope(&mut engine);
+                let _ = engine.set_param(b.param, b.max);
+                let high = raw_envelope(&mut engine);
+                let _ = engine.set_param(b.param, b.default);
+                engine.apply_pending_changes();
+                (low.scaled(envelope.scale), high.scaled(envelope.scale))
+            })
+        })
+        .collect();
 
     let num_outputs = info.num_outputs();
     Ok(Prepared {
@@ -306,6 +372,7 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
         note_input,
         macros,
         envelope,
+        macro_envelopes,
         worst_load,
         settings,
         sample_rate,
@@ -422,6 +489,18 @@ fn worst_load(report: &ressort_engine::StabilityReport) -> (f64, String) {
 /// bound rejects unit gains, the whole envelope is scaled so that unit gains sit exactly at
 /// the headroom. The clamp then never takes away what the script asks for.
 fn envelope(engine: &mut Engine) -> StabilityEnvelope {
+    let raw = raw_envelope(engine);
+    let unit = raw.lines.iter().map(|l| l.k + l.z).fold(0.0, f64::max);
+    let scale = if unit > STABILITY_HEADROOM {
+        STABILITY_HEADROOM / unit
+    } else {
+        1.0
+    };
+    raw.scaled(scale)
+}
+
+/// The envelope of the model's current parameter values, unscaled.
+fn raw_envelope(engine: &mut Engine) -> StabilityEnvelope {
     let coupled = |r: &ressort_engine::StabilityReport| -> Vec<f64> {
         r.masses.iter().map(|m| m.coupled_load()).collect()
     };
@@ -432,19 +511,10 @@ fn envelope(engine: &mut Engine) -> StabilityEnvelope {
     let z = coupled(&engine.stability());
     engine.set_class_gain(ScaleClass::Stiffness, 1.0);
     engine.apply_pending_changes();
-    let unit = k.iter().zip(&z).map(|(k, z)| k + z).fold(0.0, f64::max);
-    let scale = if unit > STABILITY_HEADROOM {
-        STABILITY_HEADROOM / unit
-    } else {
-        1.0
-    };
     let loads = k
         .into_iter()
         .zip(z)
-        .map(|(k, z)| LoadLine {
-            k: k * scale,
-            z: z * scale,
-        })
+        .map(|(k, z)| LoadLine { k, z })
         .collect();
     StabilityEnvelope::from_loads(loads)
 }

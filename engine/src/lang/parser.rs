@@ -814,7 +814,7 @@ impl Builder<'_> {
             digits
                 .parse::<u32>()
                 .ok()
-                .filter(|&k| k >= 1 && k <= MAX_HOST_INPUT)
+                .filter(|k| (1..=MAX_HOST_INPUT).contains(k))
         };
         let conflict = |diags: &mut Diags, what: &str| {
             diags.push(at.diag(
