@@ -1,60 +1,39 @@
 //! What a script tells the plugin beyond the physics: input routing, the MIDI note target,
 //! the reference pitch and key, and macro ranges.
 
-use ressort_engine::{ModelSpec, RouteSource};
+use ressort_engine::{MacroRange, ModelSpec, RouteSource};
 
-/// A host audio channel that can feed a model input.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum InputSource {
-    MainLeft,
-    MainRight,
-    SidechainLeft,
-    SidechainRight,
-    /// Fed by nothing (only MIDI, when it is the note input).
-    Silent,
-}
-
-impl InputSource {
-    /// The default order: `@in1`, `@in2`… take the main input's left and right channels when
-    /// the plugin has a main input (effect layout), then the sidechain's.
-    pub fn default_order(has_main_input: bool) -> &'static [InputSource] {
-        if has_main_input {
-            &[
-                InputSource::MainLeft,
-                InputSource::MainRight,
-                InputSource::SidechainLeft,
-                InputSource::SidechainRight,
-            ]
-        } else {
-            &[InputSource::SidechainLeft, InputSource::SidechainRight]
-        }
-    }
-
-    /// Index into the plugin's per-chunk host channel scratch.
-    pub fn channel(self) -> Option<usize> {
-        match self {
-            InputSource::MainLeft => Some(0),
-            InputSource::MainRight => Some(1),
-            InputSource::SidechainLeft => Some(2),
-            InputSource::SidechainRight => Some(3),
-            InputSource::Silent => None,
-        }
+/// The default order: `@in1`, `@in2`… take the main input's left and right channels when
+/// the plugin has a main input (effect layout), then the sidechain's.
+pub fn default_order(has_main_input: bool) -> &'static [RouteSource] {
+    if has_main_input {
+        &[
+            RouteSource::MainLeft,
+            RouteSource::MainRight,
+            RouteSource::SidechainLeft,
+            RouteSource::SidechainRight,
+        ]
+    } else {
+        &[RouteSource::SidechainLeft, RouteSource::SidechainRight]
     }
 }
 
-/// A macro range declared by the script.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MacroRange {
-    pub name: String,
-    pub min: f64,
-    pub max: f64,
+/// Index of a host channel in the plugin's per-chunk scratch; None for `none`.
+pub fn channel(source: RouteSource) -> Option<usize> {
+    match source {
+        RouteSource::MainLeft => Some(0),
+        RouteSource::MainRight => Some(1),
+        RouteSource::SidechainLeft => Some(2),
+        RouteSource::SidechainRight => Some(3),
+        RouteSource::None => None,
+    }
 }
 
 /// The plugin-facing settings of a model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HostSettings {
     /// Per model input (index 0 = `@in1`): the host channel chosen by the script.
-    pub routing: Vec<Option<InputSource>>,
+    pub routing: Vec<Option<RouteSource>>,
     /// The model input (0-based) that MIDI notes strike; default: the first force input.
     pub note_input: Option<u32>,
     /// The force of a full-velocity note, before the Force gain.
@@ -79,31 +58,19 @@ impl Default for HostSettings {
     }
 }
 
-impl From<RouteSource> for InputSource {
-    fn from(r: RouteSource) -> InputSource {
-        match r {
-            RouteSource::MainLeft => InputSource::MainLeft,
-            RouteSource::MainRight => InputSource::MainRight,
-            RouteSource::SidechainLeft => InputSource::SidechainLeft,
-            RouteSource::SidechainRight => InputSource::SidechainRight,
-            RouteSource::None => InputSource::Silent,
-        }
-    }
-}
-
 impl HostSettings {
     /// Reads the host directives of a parsed model (`~pitch`, `~key`, `~note`, `~route`,
     /// `~macro`; see docs/LANGUAGE.md §12.3).
     pub fn from_spec(spec: &ModelSpec) -> Result<HostSettings, Vec<String>> {
         let h = &spec.host;
         let defaults = HostSettings::default();
-        let mut routing: Vec<Option<InputSource>> = Vec::new();
+        let mut routing: Vec<Option<RouteSource>> = Vec::new();
         for r in &h.routes {
             let i = r.input as usize - 1;
             if routing.len() <= i {
                 routing.resize(i + 1, None);
             }
-            routing[i] = Some(r.source.into());
+            routing[i] = Some(r.source);
         }
         Ok(HostSettings {
             routing,
@@ -111,15 +78,7 @@ impl HostSettings {
             note_force: h.note_force.unwrap_or(defaults.note_force),
             reference_pitch_hz: h.pitch_hz,
             reference_key: h.key.unwrap_or(defaults.reference_key),
-            macro_ranges: h
-                .macro_ranges
-                .iter()
-                .map(|m| MacroRange {
-                    name: m.name.clone(),
-                    min: m.min,
-                    max: m.max,
-                })
-                .collect(),
+            macro_ranges: h.macro_ranges.clone(),
         })
     }
 }

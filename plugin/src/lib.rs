@@ -23,8 +23,8 @@ pub mod presets;
 pub mod runtime;
 
 use dsp::{db_to_gain, soft_ceiling, tuning_gain, ChunkSmoother, DcBlocker};
-use host::InputSource;
 use params::RessortParams;
+use ressort_engine::RouteSource;
 use runtime::RuntimeStatus;
 
 /// Length of the crossfade from a replaced model to the new one.
@@ -339,7 +339,7 @@ impl Ressort {
     fn fill_inputs(
         model: &mut Prepared,
         host_in: &[[f64; CHUNK]; 4],
-        order: &[InputSource],
+        order: &[RouteSource],
         len: usize,
         force: f64,
         position: f64,
@@ -354,7 +354,7 @@ impl Ressort {
             };
             let rest = model.rest[k];
             let dst = &mut model.inputs[k * len..(k + 1) * len];
-            match source.and_then(InputSource::channel) {
+            match source.and_then(host::channel) {
                 Some(c) if gain != 0.0 => {
                     for (d, s) in dst.iter_mut().zip(&host_in[c][..len]) {
                         *d = rest + s * gain;
@@ -379,6 +379,19 @@ impl Ressort {
         let rt = &self.store.runtime;
         rt.guard_trips.fetch_add(1, Ordering::AcqRel);
         rt.guard_active.store(true, Ordering::Release);
+    }
+}
+
+/// Copies host samples from `start` into `dst` as f64; non-finite samples and samples past
+/// the channel's end read 0.
+#[inline]
+fn read_channel(dst: &mut [f64], src: &[f32], start: usize) {
+    let src = src.get(start..).unwrap_or(&[]);
+    for (i, d) in dst.iter_mut().enumerate() {
+        *d = match src.get(i) {
+            Some(s) if s.is_finite() => *s as f64,
+            _ => 0.0,
+        };
     }
 }
 
@@ -484,7 +497,7 @@ impl Plugin for Ressort {
         let started = std::time::Instant::now();
         self.receive_models();
         let frames = buffer.samples();
-        let order = InputSource::default_order(self.has_main_input);
+        let order = host::default_order(self.has_main_input);
         let mut loudest: f64 = 0.0;
         let mut pos = 0;
         while pos < frames {
@@ -497,21 +510,12 @@ impl Plugin for Ressort {
             }
             if self.has_main_input {
                 for (c, ch) in buffer.as_slice_immutable().iter().take(2).enumerate() {
-                    for (d, s) in self.host_in[c][..len].iter_mut().zip(&ch[pos..pos + len]) {
-                        *d = if s.is_finite() { *s as f64 } else { 0.0 };
-                    }
+                    read_channel(&mut self.host_in[c][..len], ch, pos);
                 }
             }
             if let Some(sc) = aux.inputs.first() {
                 for (c, ch) in sc.as_slice_immutable().iter().take(2).enumerate() {
-                    if ch.len() >= pos + len {
-                        for (d, s) in self.host_in[2 + c][..len]
-                            .iter_mut()
-                            .zip(&ch[pos..pos + len])
-                        {
-                            *d = if s.is_finite() { *s as f64 } else { 0.0 };
-                        }
-                    }
+                    read_channel(&mut self.host_in[2 + c][..len], ch, pos);
                 }
             }
             for row in &self.host_in {

@@ -8,12 +8,12 @@
 //! so it never allocates or frees. A script with errors never replaces the running model; its
 //! diagnostics are kept in [`ModelStore::status`] for the editor.
 
-use crate::host::{HostSettings, InputSource};
+use crate::host::HostSettings;
 use crate::runtime::RuntimeStatus;
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::params::persist::PersistentField;
 use ressort_engine::{
-    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, ParamId, ScaleClass,
+    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, ParamId, RouteSource, ScaleClass,
 };
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -130,11 +130,7 @@ impl StabilityEnvelope {
     /// model's own stiffness away), then Stiffness takes what remains. Returns the gains and
     /// whether anything was clamped.
     pub fn clamp(&self, gk: f64, gz: f64, k_floor: f64) -> (f64, f64, bool) {
-        // A relative tolerance so that a limit computed as 0.999…9 still admits unit gains.
-        const TOLERANCE: f64 = 1.0 + 1e-9;
-        let z = gz.min(self.max_damping(gk.min(k_floor)) * TOLERANCE);
-        let k = gk.min(self.max_stiffness(z) * TOLERANCE);
-        (k, z, k < gk || z < gz)
+        self.clamp_moved(gk, gz, k_floor, &[])
     }
 
     fn from_loads(mut loads: Vec<LoadLine>) -> StabilityEnvelope {
@@ -217,7 +213,7 @@ pub struct Prepared {
     /// One entry per model input channel (`@in1` first).
     pub roles: Vec<InputRole>,
     /// The host channel feeding each model input, when the script chose one.
-    pub routing: Vec<Option<InputSource>>,
+    pub routing: Vec<Option<RouteSource>>,
     /// The declared position of each position input's avatar (0 for other inputs): a
     /// `posInput` receives rest + signal × Position gain.
     pub rest: Vec<f64>,

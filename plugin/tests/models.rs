@@ -209,7 +209,7 @@ fn host_directives_configure_the_plugin() {
     assert_eq!(
         p.routing,
         vec![
-            Some(ressort_plugin::host::InputSource::SidechainRight),
+            Some(ressort_engine::RouteSource::SidechainRight),
             None,
             None
         ]

@@ -823,6 +823,21 @@ impl Builder<'_> {
                 format!("a second `~{name}` for {what}"),
             ));
         };
+        // `~note` and `~route` start with an input.
+        let k = if matches!(name, "note" | "route") {
+            let Some(k) = input(&args[0]) else {
+                bad(
+                    &mut self.diags,
+                    args[0].col,
+                    format!("`{}` is not an input", args[0].source()),
+                    Some(args[0].source()),
+                );
+                return;
+            };
+            k
+        } else {
+            0
+        };
         let host = &mut self.spec.host;
         match name {
             "pitch" => match number(&args[0]).filter(|v| *v > 0.0) {
@@ -846,15 +861,6 @@ impl Builder<'_> {
                 ),
             },
             "note" => {
-                let Some(k) = input(&args[0]) else {
-                    bad(
-                        &mut self.diags,
-                        args[0].col,
-                        format!("`{}` is not an input", args[0].source()),
-                        Some(args[0].source()),
-                    );
-                    return;
-                };
                 let force = match args.get(1) {
                     Some(t) => match number(t) {
                         Some(v) => Some(v),
@@ -878,15 +884,6 @@ impl Builder<'_> {
                 host.note_force = force;
             }
             "route" => {
-                let Some(k) = input(&args[0]) else {
-                    bad(
-                        &mut self.diags,
-                        args[0].col,
-                        format!("`{}` is not an input", args[0].source()),
-                        Some(args[0].source()),
-                    );
-                    return;
-                };
                 let Some(source) = RouteSource::from_name(&args[1].string()) else {
                     bad(
                         &mut self.diags,
