@@ -33,7 +33,9 @@ pub mod spec;
 pub mod stability;
 
 pub use compile::{compile, CompileError, CompileErrorKind, CompileErrors, CompileOptions};
-pub use engine::{BlockReport, Engine, GuardEvent, GuardKind, ParamError, ParamId};
+pub use engine::{
+    BlockReport, Engine, GuardEvent, GuardKind, IoKind, IoPoint, ParamError, ParamId,
+};
 pub use expr::{BinOp, Expr, Func};
 pub use info::{InputUse, ModelInfo, OutputUse, PointInfo, PointKind};
 pub use lang::{parse, parse_bytes, print, Diagnostic, DiagnosticCode, Parsed, Severity};

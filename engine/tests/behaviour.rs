@@ -532,3 +532,41 @@ fn coupled_loads_bound_chains_of_single_masses() {
     let out = render(&mut e, 20_000, 64, &[impulse(-1e-3, 20_000)]);
     assert!(!e.is_tripped() && out[0].iter().all(|x| x.abs() < 1e-2));
 }
+
+/// Displays find inputs and outputs on material points, connection points on their heaviest
+/// node, and explicit interactions as point pairs.
+#[test]
+fn io_points_and_links_locate_on_material_points() {
+    use ressort_engine::{IoKind, PointKind};
+    let text = include_str!("../../models/mesh-15x15.mdl");
+    let spec = ressort_engine::parse(text).spec.expect("preset parses");
+    let e = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
+    let info = e.info();
+    let label = |p: u32| info.point_label(p as usize);
+    let io = e.io_points();
+    assert_eq!(io.len(), 2, "{io:?}");
+    let input = io.iter().find(|p| p.kind == IoKind::ForceInput).unwrap();
+    assert_eq!((input.channel, label(input.point).as_str()), (1, "h"));
+    let output = io.iter().find(|p| p.kind == IoKind::PositionOutput).unwrap();
+    assert_eq!(output.channel, 1);
+    // [@mesh 0.75 0.6] on 15 × 15 nodes sits at (10.5, 8.4): the heaviest corner is row 10
+    // or 11 (equal weights), column 8.
+    let out_label = label(output.point);
+    assert!(
+        out_label == "mesh[10,8]" || out_label == "mesh[11,8]",
+        "{out_label}"
+    );
+    assert!(matches!(
+        info.points[output.point as usize].kind,
+        PointKind::MacroNode { .. }
+    ));
+    let links: Vec<(String, String)> = e
+        .links()
+        .into_iter()
+        .map(|(a, b)| (label(a), label(b)))
+        .collect();
+    assert_eq!(links.len(), 2, "{links:?}");
+    assert!(links.contains(&("gh".into(), "h".into())), "{links:?}");
+    // The hammer's contact [@mesh 0.3 0.2] is at (4.2, 2.8): heaviest node (4, 3).
+    assert!(links.contains(&("mesh[4,3]".into(), "h".into())), "{links:?}");
+}
