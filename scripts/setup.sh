@@ -18,6 +18,9 @@ packages=(
   libxrandr-dev
   libxi-dev
   libgl1-mesa-dev
+  # The editor check: a virtual X server and Mesa's software OpenGL.
+  xvfb
+  libgl1-mesa-dri
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -547,7 +547,10 @@ fn io_points_and_links_locate_on_material_points() {
     assert_eq!(io.len(), 2, "{io:?}");
     let input = io.iter().find(|p| p.kind == IoKind::ForceInput).unwrap();
     assert_eq!((input.channel, label(input.point).as_str()), (1, "h"));
-    let output = io.iter().find(|p| p.kind == IoKind::PositionOutput).unwrap();
+    let output = io
+        .iter()
+        .find(|p| p.kind == IoKind::PositionOutput)
+        .unwrap();
     assert_eq!(output.channel, 1);
     // [@mesh 0.75 0.6] on 15 × 15 nodes sits at (10.5, 8.4): the heaviest corner is row 10
     // or 11 (equal weights), column 8.
@@ -568,5 +571,8 @@ fn io_points_and_links_locate_on_material_points() {
     assert_eq!(links.len(), 2, "{links:?}");
     assert!(links.contains(&("gh".into(), "h".into())), "{links:?}");
     // The hammer's contact [@mesh 0.3 0.2] is at (4.2, 2.8): heaviest node (4, 3).
-    assert!(links.contains(&("mesh[4,3]".into(), "h".into())), "{links:?}");
+    assert!(
+        links.contains(&("mesh[4,3]".into(), "h".into())),
+        "{links:?}"
+    );
 }

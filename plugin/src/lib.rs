@@ -16,9 +16,12 @@ use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
 pub mod dsp;
+pub mod editor;
 pub mod host;
 pub mod model;
+pub mod motion;
 pub mod params;
+pub mod plot;
 pub mod presets;
 pub mod runtime;
 
@@ -37,6 +40,10 @@ const QUIET_LEVEL: f64 = 1e-6;
 const CONTROL_SMOOTHING_MS: f64 = 15.0;
 /// Smoothing time constant of the gains.
 const GAIN_SMOOTHING_MS: f64 = 5.0;
+/// Interval of the editor's repeated strike (Audition).
+const AUDITION_INTERVAL_S: f64 = 1.0;
+/// Velocity of the editor's strikes.
+const AUDITION_VELOCITY: f64 = 0.8;
 /// The Stiffness gain that Damping can never take away through the stability clamp: the
 /// model's own stiffness.
 const KEPT_STIFFNESS_GAIN: f64 = 1.0;
@@ -44,6 +51,9 @@ const KEPT_STIFFNESS_GAIN: f64 = 1.0;
 pub struct Ressort {
     params: Arc<RessortParams>,
     store: Arc<ModelStore>,
+    editor_state: Arc<nice_plug_egui::EguiEditorState>,
+    /// Samples until the next Audition strike.
+    audition_left: u64,
     sample_rate: f64,
     has_main_input: bool,
     current: Option<Box<Prepared>>,
@@ -73,16 +83,46 @@ pub struct Ressort {
     /// Samples since activation: chunk boundaries are multiples of CHUNK.
     counter: u64,
     quiet_samples: u64,
+    /// A strike from the editor waits for the next chunk.
+    pending_strike: bool,
     host_in: [[f64; CHUNK]; 4],
+}
+
+/// How `ressort-standalone` starts: its `--model` and `--audition` options.
+#[derive(Clone, Debug, Default)]
+pub struct StandaloneStart {
+    pub model: Option<model::ModelState>,
+    pub audition: bool,
+}
+
+static STANDALONE_START: std::sync::OnceLock<StandaloneStart> = std::sync::OnceLock::new();
+
+/// Sets how the instances of this process start; called once by `ressort-standalone` before
+/// it creates the plugin. Plugin hosts never call it.
+pub fn set_standalone_start(start: StandaloneStart) {
+    let _ = STANDALONE_START.set(start);
 }
 
 impl Default for Ressort {
     fn default() -> Self {
         let store = Arc::new(ModelStore::default());
+        if let Some(start) = STANDALONE_START.get() {
+            if let Some(model) = &start.model {
+                // Checked now; compiled at activation. A bad script keeps the default model
+                // and its diagnostics show in the editor.
+                let _ = store.submit(model.clone());
+            }
+            store
+                .runtime
+                .audition
+                .store(start.audition, Ordering::Release);
+        }
         let params = Arc::new(RessortParams::new(store.clone()));
         Ressort {
             params,
             store,
+            editor_state: editor::default_state(),
+            audition_left: 0,
             sample_rate: 48_000.0,
             has_main_input: false,
             current: None,
@@ -106,6 +146,7 @@ impl Default for Ressort {
             pending_event: None,
             counter: 0,
             quiet_samples: 0,
+            pending_strike: false,
             host_in: [[0.0; CHUNK]; 4],
         }
     }
@@ -277,6 +318,8 @@ impl Ressort {
         rt.damping_gain.store(gz, Ordering::Relaxed);
         rt.requested_stiffness_gain
             .store(requested_k, Ordering::Relaxed);
+        rt.requested_damping_gain
+            .store(requested_z, Ordering::Relaxed);
         rt.clamped.store(clamped, Ordering::Relaxed);
     }
 
@@ -365,14 +408,39 @@ impl Ressort {
         }
     }
 
-    /// The guard reset the model: count it, raise the flag, fade back in.
-    fn guard_tripped(&mut self) {
+    /// Puts the model back at rest and fades the output back in.
+    fn restart_model(&mut self) {
         if let Some(model) = self.current.as_mut() {
             model.engine.reset();
         }
         self.dc.iter_mut().for_each(DcBlocker::reset);
         self.guard_gain = 0.0;
         self.guard_step = 1.0 / (GUARD_FADE_MS * 1e-3 * self.sample_rate).max(1.0);
+    }
+
+    /// The editor's requests: reset the model, strike it once or repeatedly. Realtime-safe.
+    fn editor_requests(&mut self) {
+        let store = self.store.clone();
+        let rt = &store.runtime;
+        if rt.reset_requested.swap(false, Ordering::AcqRel) {
+            rt.guard_active.store(false, Ordering::Release);
+            self.restart_model();
+        }
+        let mut strike = rt.strike_requested.swap(false, Ordering::AcqRel);
+        if rt.audition.load(Ordering::Acquire) {
+            if self.audition_left == 0 {
+                strike = true;
+                self.audition_left = (AUDITION_INTERVAL_S * self.sample_rate) as u64;
+            }
+        } else {
+            self.audition_left = 0;
+        }
+        self.pending_strike |= strike;
+    }
+
+    /// The guard reset the model: count it, raise the flag, fade back in.
+    fn guard_tripped(&mut self) {
+        self.restart_model();
         // Atomics only: nice-plug 0.4.2's shared background worker exits when it runs a task
         // of an instance that is gone, and the next instance's destruction then aborts the
         // host, so the audio thread never queues tasks.
@@ -438,10 +506,18 @@ impl Plugin for Ressort {
 
     type SysExMessage = ();
     type BackgroundTask = ();
-    type Editor = ();
+    type Editor = nice_plug_egui::EguiEditor<editor::EditorApp>;
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()
+    }
+
+    fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
+        editor::create(
+            self.params.clone(),
+            self.store.clone(),
+            self.editor_state.clone(),
+        )
     }
 
     fn activate(
@@ -496,6 +572,8 @@ impl Plugin for Ressort {
     ) -> ProcessStatus {
         let started = std::time::Instant::now();
         self.receive_models();
+        self.editor_requests();
+        let editor_open = self.editor_state.is_open();
         let frames = buffer.samples();
         let order = host::default_order(self.has_main_input);
         let mut loudest: f64 = 0.0;
@@ -534,6 +612,16 @@ impl Plugin for Ressort {
             if self.handle_events(context, pos, len) {
                 self.apply_controls(false);
             }
+            if self.pending_strike {
+                self.pending_strike = false;
+                if let Some(model) = self.current.as_mut() {
+                    if let Some(k) = model.note_input {
+                        model.inputs[k * len] +=
+                            model.settings.note_force * AUDITION_VELOCITY * force;
+                    }
+                }
+            }
+            self.audition_left = self.audition_left.saturating_sub(len as u64);
 
             let mut tripped = false;
             if let Some(model) = self.current.as_mut() {
@@ -545,6 +633,9 @@ impl Plugin for Ressort {
                     &mut model.outputs[..n_out * len],
                 );
                 tripped |= report.tripped;
+                model
+                    .motion
+                    .tick(len, model.engine.positions(), editor_open);
             }
             if let Some(old) = self.outgoing.as_mut() {
                 let n_in = old.roles.len();

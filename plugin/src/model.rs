@@ -9,6 +9,7 @@
 //! diagnostics are kept in [`ModelStore::status`] for the editor.
 
 use crate::host::HostSettings;
+use crate::motion::{motion_channel, MotionReader, MotionWriter};
 use crate::runtime::RuntimeStatus;
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::params::persist::PersistentField;
@@ -226,6 +227,10 @@ pub struct Prepared {
     pub macro_envelopes: Vec<Option<(StabilityEnvelope, StabilityEnvelope)>>,
     /// Loads at unit gains: (worst load, label of the worst mass or structure).
     pub worst_load: (f64, String),
+    /// Publishes the positions for the editor.
+    pub motion: MotionWriter,
+    /// The editor's end of `motion`, until the store takes it.
+    pub motion_reader: Option<MotionReader>,
 }
 
 /// A model's description for the editor and the tests: counts and analysis, made when it
@@ -358,7 +363,10 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
         .collect();
 
     let num_outputs = info.num_outputs();
+    let (motion, motion_reader) = motion_channel(&engine, sample_rate);
     Ok(Prepared {
+        motion,
+        motion_reader: Some(motion_reader),
         inputs: vec![0.0; roles.len() * CHUNK],
         outputs: vec![0.0; num_outputs.max(1) * CHUNK],
         num_outputs,
@@ -683,6 +691,9 @@ pub struct ModelStore {
     generation: AtomicU64,
     to_audio: (Sender<Box<Prepared>>, Receiver<Box<Prepared>>),
     garbage: (Sender<Box<Prepared>>, Receiver<Box<Prepared>>),
+    /// The motion reader of the newest model sent to the audio thread, until the editor
+    /// takes it.
+    motion: Mutex<Option<MotionReader>>,
     /// What the audio thread reports.
     pub runtime: RuntimeStatus,
 }
@@ -700,6 +711,7 @@ impl Default for ModelStore {
             generation: AtomicU64::new(0),
             to_audio: crossbeam_channel::bounded(4),
             garbage: crossbeam_channel::bounded(64),
+            motion: Mutex::new(None),
             runtime: RuntimeStatus::default(),
         }
     }
@@ -728,6 +740,12 @@ impl ModelStore {
             Some(Some(b)) => format!("{} = {}", b.name, format_value(b.value_at(normalized))),
             _ => format!("unbound ({:.0} %)", normalized * 100.0),
         }
+    }
+
+    /// The motion reader of the newest model, once: the editor keeps it until a newer model
+    /// arrives.
+    pub fn take_motion_reader(&self) -> Option<MotionReader> {
+        lock(&self.motion).take()
     }
 
     /// How many models have been sent to the audio thread.
@@ -761,6 +779,7 @@ impl ModelStore {
                 if let Some(mut p) = prepared {
                     status.summary = p.summary();
                     drop(status);
+                    *lock(&self.motion) = p.motion_reader.take();
                     self.send(Box::new(p));
                 }
                 *lock(&self.running) = state;
@@ -808,6 +827,7 @@ impl ModelStore {
             }
         };
         lock(&self.status).summary = prepared.summary();
+        *lock(&self.motion) = prepared.motion_reader.take();
         Some(Box::new(prepared))
     }
 

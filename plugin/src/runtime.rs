@@ -21,6 +21,15 @@ pub struct RuntimeStatus {
     pub cpu_load: AtomicF64,
     /// How many models the audio thread has switched to.
     pub running_generation: AtomicU64,
+    /// The Damping gain asked for, before the clamp.
+    pub requested_damping_gain: AtomicF64,
+    /// Set by the editor's Strike button: the audio thread strikes the note input once.
+    pub strike_requested: AtomicBool,
+    /// The editor's Audition switch: strike the note input every second.
+    pub audition: AtomicBool,
+    /// Set by the editor's reset button; the audio thread resets the model at its next block
+    /// and clears the guard flag.
+    pub reset_requested: AtomicBool,
 }
 
 impl Default for RuntimeStatus {
@@ -34,6 +43,10 @@ impl Default for RuntimeStatus {
             clamped: AtomicBool::new(false),
             cpu_load: AtomicF64::new(0.0),
             running_generation: AtomicU64::new(0),
+            requested_damping_gain: AtomicF64::new(1.0),
+            strike_requested: AtomicBool::new(false),
+            audition: AtomicBool::new(false),
+            reset_requested: AtomicBool::new(false),
         }
     }
 }

@@ -1,0 +1,855 @@
+//! The editor: a resizable egui window (nice-plug-egui) with the motion view, the model panel
+//! (presets, files, script editor with diagnostics), the controls and the status.
+//!
+//! Everything it shows comes from the [`ModelStore`] (the running model's summary, the last
+//! submission's diagnostics), the [`crate::runtime::RuntimeStatus`] atomics (clamp, guard,
+//! CPU load) and the model's [`MotionReader`]. It changes the model only through
+//! [`ModelStore::submit`], so a script with errors never replaces the running one, and the
+//! parameters only through the host's `ParamSetter`.
+
+use crate::model::{ModelState, ModelStatus, ModelStore, NUM_MACROS};
+use crate::motion::MotionReader;
+use crate::params::RessortParams;
+use crate::plot::{PlotState, ZMode};
+use crate::presets::{Preset, PRESETS};
+use egui::{Color32, RichText, Ui};
+use nice_plug::context::gui::GuiContext;
+use nice_plug::editor::dpi::LogicalSize;
+use nice_plug::editor::{ResizeHint, SizeConstraints};
+use nice_plug_egui::widgets::ParamSlider;
+use nice_plug_egui::{
+    create_egui_editor, EguiEditor, EguiEditorState, EguiNiceSettings, NiceEguiApp, RepaintNotifier,
+};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The editor's size when first opened, in logical pixels.
+pub const DEFAULT_SIZE: (f32, f32) = (1100.0, 700.0);
+/// The smallest size the window can be resized to.
+pub const MIN_SIZE: (f32, f32) = (780.0, 500.0);
+/// Largest file the model panel loads.
+const MAX_SCRIPT_BYTES: u64 = 16 << 20;
+
+const ORANGE: Color32 = Color32::from_rgb(255, 165, 60);
+const RED: Color32 = Color32::from_rgb(255, 90, 80);
+const GREEN: Color32 = Color32::from_rgb(120, 220, 130);
+
+/// The editor state shared with the plugin: size and whether the window is open.
+pub fn default_state() -> Arc<EguiEditorState> {
+    EguiEditorState::from_size(LogicalSize::new(DEFAULT_SIZE.0, DEFAULT_SIZE.1), 1.0)
+}
+
+/// The plugin's editor.
+pub fn create(
+    params: Arc<RessortParams>,
+    store: Arc<ModelStore>,
+    state: Arc<EguiEditorState>,
+) -> Option<EguiEditor<EditorApp>> {
+    let settings = EguiNiceSettings::new()
+        .with_tile("Ressort")
+        .with_resize_hint(ResizeHint {
+            size_constraints: SizeConstraints::Logical {
+                min_size: Some(LogicalSize::new(MIN_SIZE.0, MIN_SIZE.1)),
+                max_size: None,
+            },
+            ..ResizeHint::RESIZABLE
+        });
+    create_egui_editor(
+        state,
+        RepaintNotifier::new(),
+        settings,
+        EditorApp::new(params, store),
+    )
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Tab {
+    Presets,
+    Script,
+    File,
+}
+
+/// A diagnostic line split into its position and message.
+#[derive(Clone, Debug, PartialEq)]
+struct Diagnostic {
+    line: usize,
+    col: usize,
+    text: String,
+}
+
+impl Diagnostic {
+    /// `LINE:COL: severity: message`; lines without a position count as line 1.
+    fn parse(s: &str) -> Diagnostic {
+        let mut parts = s.splitn(3, ':');
+        let line = parts.next().and_then(|p| p.trim().parse().ok());
+        let col = parts.next().and_then(|p| p.trim().parse().ok());
+        match (line, col, parts.next()) {
+            (Some(line), Some(col), Some(rest)) => Diagnostic {
+                line,
+                col,
+                text: rest.trim().to_string(),
+            },
+            _ => Diagnostic {
+                line: 1,
+                col: 1,
+                text: s.to_string(),
+            },
+        }
+    }
+}
+
+/// A minimal file browser for `.mdl` scripts.
+struct FileBrowser {
+    dir: PathBuf,
+    path_text: String,
+    entries: Vec<(String, bool)>,
+    error: Option<String>,
+}
+
+impl FileBrowser {
+    fn new() -> FileBrowser {
+        let dir = std::env::var_os("HOME")
+            .map(PathBuf::from)
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_else(|| PathBuf::from("/"));
+        let mut b = FileBrowser {
+            path_text: dir.display().to_string(),
+            dir,
+            entries: Vec::new(),
+            error: None,
+        };
+        b.refresh();
+        b
+    }
+
+    fn go(&mut self, dir: PathBuf) {
+        self.dir = dir;
+        self.path_text = self.dir.display().to_string();
+        self.refresh();
+    }
+
+    fn refresh(&mut self) {
+        self.entries.clear();
+        self.error = None;
+        match std::fs::read_dir(&self.dir) {
+            Ok(rd) => {
+                for e in rd.flatten() {
+                    let name = e.file_name().to_string_lossy().into_owned();
+                    if name.starts_with('.') {
+                        continue;
+                    }
+                    let is_dir = e.file_type().map(|t| t.is_dir()).unwrap_or(false);
+                    if is_dir || name.ends_with(".mdl") {
+                        self.entries.push((name, is_dir));
+                    }
+                }
+                self.entries
+                    .sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+            }
+            Err(e) => self.error = Some(format!("{}: {e}", self.dir.display())),
+        }
+    }
+}
+
+/// Reads a script file for the model panel.
+fn read_script(path: &Path) -> Result<String, String> {
+    let meta = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if meta.len() > MAX_SCRIPT_BYTES {
+        return Err(format!(
+            "{}: {} bytes is larger than the {} MB a script may have",
+            path.display(),
+            meta.len(),
+            MAX_SCRIPT_BYTES >> 20
+        ));
+    }
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(String::from_utf8_lossy(&bytes).into_owned())
+}
+
+/// The editor's state between frames.
+pub struct EditorApp {
+    params: Arc<RessortParams>,
+    store: Arc<ModelStore>,
+    gui: Option<GuiContext>,
+    reader: Option<MotionReader>,
+    plot: PlotState,
+    tab: Tab,
+    preset: usize,
+    /// The text in the script editor, and the name it will be applied under.
+    script: String,
+    script_name: String,
+    /// The running script the editor last showed: when the running model changes (a preset,
+    /// a state load) and the text has not been edited, the editor follows.
+    synced: ModelState,
+    message: Option<(String, Color32)>,
+    browser: FileBrowser,
+    last_frame: Option<Instant>,
+    frame_times: [f32; 32],
+    frame_count: usize,
+}
+
+impl EditorApp {
+    pub fn new(params: Arc<RessortParams>, store: Arc<ModelStore>) -> EditorApp {
+        let running = store.running();
+        let preset = PRESETS
+            .iter()
+            .position(|p| p.id == running.name)
+            .unwrap_or(0);
+        EditorApp {
+            params,
+            script: running.script.clone(),
+            script_name: running.name.clone(),
+            synced: running,
+            store,
+            gui: None,
+            reader: None,
+            plot: PlotState::default(),
+            tab: Tab::Presets,
+            preset,
+            message: None,
+            browser: FileBrowser::new(),
+            last_frame: None,
+            frame_times: [0.0; 32],
+            frame_count: 0,
+        }
+    }
+
+    /// Frames per second over the last 32 frames.
+    fn fps(&self) -> f32 {
+        let n = self.frame_count.min(self.frame_times.len());
+        let total: f32 = self.frame_times[..n].iter().sum();
+        if total > 0.0 {
+            n as f32 / total
+        } else {
+            0.0
+        }
+    }
+
+    /// Follows the running model when the script editor holds no edits of its own.
+    fn sync_script(&mut self) {
+        let running = self.store.running();
+        if running != self.synced {
+            if self.script == self.synced.script {
+                self.script = running.script.clone();
+                self.script_name = running.name.clone();
+            }
+            self.synced = running;
+        }
+    }
+
+    fn submit(&mut self, name: String, script: String) {
+        let state = ModelState {
+            name: name.clone(),
+            script: script.clone(),
+        };
+        match self.store.submit(state) {
+            Ok(()) => {
+                self.message = Some((format!("{name} is running"), GREEN));
+                self.script = script;
+                self.script_name = name;
+                self.synced = self.store.running();
+            }
+            Err(rejected) => {
+                self.script = script;
+                self.script_name = name;
+                self.tab = Tab::Script;
+                let n = rejected.0.len();
+                self.message = Some((
+                    format!(
+                        "{n} error{} — the running model is unchanged",
+                        if n == 1 { "" } else { "s" }
+                    ),
+                    RED,
+                ));
+            }
+        }
+    }
+
+    fn top_bar(&mut self, ui: &mut Ui, status: &ModelStatus) {
+        let rt = &self.store.runtime;
+        let s = &status.summary;
+        ui.horizontal_wrapped(|ui| {
+            ui.label(RichText::new("Ressort").strong().size(16.0));
+            ui.separator();
+            ui.label(RichText::new(&s.name).strong());
+            ui.label(format!(
+                "{} points · {} interactions",
+                s.points, s.interactions
+            ));
+            if let Some(f) = s.reference_pitch_hz {
+                ui.label(format!("{f:.1} Hz at key {}", s.reference_key));
+            }
+            ui.separator();
+            let load = rt.cpu_load.load(Ordering::Relaxed) * 100.0;
+            ui.label(format!("CPU {load:.1} %"))
+                .on_hover_text("Time spent in the audio callback, as a share of real time");
+            ui.separator();
+            let trips = rt.guard_trips.load(Ordering::Relaxed);
+            let exploded = rt.guard_active.load(Ordering::Acquire);
+            let (dot, _) = ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
+            ui.painter()
+                .circle_filled(dot.center(), 5.0, if exploded { RED } else { GREEN });
+            if exploded {
+                ui.colored_label(RED, format!("Exploded — reset by the guard ({trips}×)"))
+                    .on_hover_text(
+                        "The model ran away; the guard silenced it, put it back at rest and \
+                         faded in. Lower Stiffness or the force that drives it.",
+                    );
+            } else {
+                ui.colored_label(GREEN, "Stable");
+            }
+            if ui
+                .button("Reset model")
+                .on_hover_text("Put every mass back at rest and clear the indicator")
+                .clicked()
+            {
+                rt.reset_requested.store(true, Ordering::Release);
+            }
+            ui.separator();
+            ui.label(
+                RichText::new(format!("{:.0} fps", self.fps()))
+                    .color(Color32::GRAY)
+                    .small(),
+            );
+        });
+    }
+
+    fn presets_tab(&mut self, ui: &mut Ui) {
+        let mut load = None;
+        egui::ScrollArea::vertical()
+            .id_salt("presets")
+            .max_height(ui.available_height() * 0.5)
+            .show(ui, |ui| {
+                for (i, p) in PRESETS.iter().enumerate() {
+                    let r = ui.selectable_label(self.preset == i, p.id);
+                    if r.clicked() {
+                        self.preset = i;
+                    }
+                    if r.double_clicked() {
+                        load = Some(i);
+                    }
+                }
+            });
+        ui.separator();
+        let p = &PRESETS[self.preset.min(PRESETS.len() - 1)];
+        ui.horizontal(|ui| {
+            ui.label(RichText::new(p.id).strong());
+            if ui.button("Load").clicked() {
+                load = Some(self.preset);
+            }
+        });
+        egui::ScrollArea::vertical()
+            .id_salt("preset-info")
+            .show(ui, |ui| {
+                for key in crate::presets::FIELDS {
+                    let text = p.header_field(key);
+                    if !text.is_empty() {
+                        ui.label(RichText::new(key).color(Color32::GRAY).small());
+                        ui.label(text);
+                        ui.add_space(4.0);
+                    }
+                }
+            });
+        if let Some(i) = load {
+            let p: &Preset = &PRESETS[i];
+            self.submit(p.id.to_string(), p.text.to_string());
+        }
+    }
+
+    fn file_tab(&mut self, ui: &mut Ui) {
+        let mut go = None;
+        let mut open = None;
+        ui.horizontal(|ui| {
+            if ui.button("Up").on_hover_text("Parent folder").clicked() {
+                if let Some(parent) = self.browser.dir.parent() {
+                    go = Some(parent.to_path_buf());
+                }
+            }
+            let r = ui.add(
+                egui::TextEdit::singleline(&mut self.browser.path_text)
+                    .desired_width(f32::INFINITY),
+            );
+            if r.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) {
+                let path = PathBuf::from(self.browser.path_text.trim());
+                if path.is_dir() {
+                    go = Some(path);
+                } else {
+                    open = Some(path);
+                }
+            }
+        });
+        ui.label(
+            RichText::new("Folders and .mdl scripts; type a path and press Enter to open it")
+                .small()
+                .color(Color32::GRAY),
+        );
+        if let Some(e) = &self.browser.error {
+            ui.colored_label(RED, e);
+        }
+        egui::ScrollArea::vertical()
+            .id_salt("files")
+            .show(ui, |ui| {
+                for (name, is_dir) in &self.browser.entries {
+                    let text = if *is_dir {
+                        format!("{name}/")
+                    } else {
+                        name.clone()
+                    };
+                    if ui.selectable_label(false, text).clicked() {
+                        let path = self.browser.dir.join(name);
+                        if *is_dir {
+                            go = Some(path);
+                        } else {
+                            open = Some(path);
+                        }
+                    }
+                }
+            });
+        if let Some(dir) = go {
+            self.browser.go(dir);
+        }
+        if let Some(path) = open {
+            match read_script(&path) {
+                Ok(text) => {
+                    let name = path
+                        .file_stem()
+                        .map(|s| s.to_string_lossy().into_owned())
+                        .unwrap_or_else(|| "script".into());
+                    self.submit(name, text);
+                }
+                Err(e) => self.message = Some((e, RED)),
+            }
+        }
+    }
+
+    fn script_tab(&mut self, ui: &mut Ui, status: &ModelStatus) {
+        let edited = self.script != self.synced.script;
+        let diagnostics: Vec<Diagnostic> = if status.rejected.is_some() {
+            status
+                .diagnostics
+                .iter()
+                .map(|d| Diagnostic::parse(d))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let shown_rejected = status
+            .rejected
+            .as_ref()
+            .is_some_and(|r| r.script == self.script);
+        let mut apply = ui.input(|i| i.modifiers.command && i.key_pressed(egui::Key::Enter));
+        ui.horizontal(|ui| {
+            if ui
+                .button("Apply")
+                .on_hover_text("Compile the script and run it (Ctrl+Enter)")
+                .clicked()
+            {
+                apply = true;
+            }
+            if ui
+                .add_enabled(edited, egui::Button::new("Revert"))
+                .on_hover_text("Back to the running script")
+                .clicked()
+            {
+                self.script = self.synced.script.clone();
+                self.script_name = self.synced.name.clone();
+            }
+            ui.label("Name");
+            ui.add(egui::TextEdit::singleline(&mut self.script_name).desired_width(120.0));
+            if edited {
+                ui.colored_label(ORANGE, "edited");
+            }
+        });
+        // Diagnostics first, so they stay visible above a long script.
+        if shown_rejected && !diagnostics.is_empty() {
+            egui::ScrollArea::vertical()
+                .id_salt("diagnostics")
+                .max_height(90.0)
+                .show(ui, |ui| {
+                    for d in &diagnostics {
+                        ui.colored_label(
+                            RED,
+                            RichText::new(format!("{}:{}: {}", d.line, d.col, d.text)).monospace(),
+                        );
+                    }
+                });
+        }
+        let error_lines: Vec<usize> = if shown_rejected {
+            diagnostics.iter().map(|d| d.line).collect()
+        } else {
+            Vec::new()
+        };
+        let mut layouter = |ui: &Ui, buf: &dyn egui::TextBuffer, wrap: f32| {
+            let mut job = egui::text::LayoutJob::default();
+            let font = egui::FontId::monospace(12.0);
+            let text_colour = ui.visuals().text_color();
+            for (n, line) in buf.as_str().split_inclusive('\n').enumerate() {
+                let bad = error_lines.contains(&(n + 1));
+                let comment = line.trim_start().starts_with('#');
+                job.append(
+                    line,
+                    0.0,
+                    egui::TextFormat {
+                        font_id: font.clone(),
+                        color: if comment {
+                            Color32::from_gray(130)
+                        } else {
+                            text_colour
+                        },
+                        background: if bad {
+                            Color32::from_rgba_unmultiplied(200, 40, 40, 90)
+                        } else {
+                            Color32::TRANSPARENT
+                        },
+                        ..Default::default()
+                    },
+                );
+            }
+            job.wrap.max_width = wrap;
+            ui.fonts_mut(|f| f.layout_job(job))
+        };
+        egui::ScrollArea::both().id_salt("script").show(ui, |ui| {
+            ui.add(
+                egui::TextEdit::multiline(&mut self.script)
+                    .code_editor()
+                    .desired_width(f32::INFINITY)
+                    .desired_rows(30)
+                    .layouter(&mut layouter),
+            );
+        });
+        if apply {
+            let name = if self.script_name.trim().is_empty() {
+                "script".to_string()
+            } else {
+                self.script_name.trim().to_string()
+            };
+            self.submit(name, self.script.clone());
+        }
+    }
+
+    fn controls(&mut self, ui: &mut Ui, status: &ModelStatus) {
+        let Some(gui) = self.gui.as_ref() else {
+            return;
+        };
+        let setter = gui.param_setter();
+        let p = &self.params;
+        let rt = &self.store.runtime;
+        let row = |ui: &mut Ui, name: &str, param: &dyn Fn(&mut Ui)| {
+            ui.horizontal(|ui| {
+                ui.add_sized([74.0, 18.0], egui::Label::new(name));
+                param(ui);
+            });
+        };
+        ui.heading("Controls");
+        row(ui, "Stiffness", &|ui| {
+            ui.add(ParamSlider::for_param(&p.stiffness, &setter));
+        });
+        if rt.clamped.load(Ordering::Relaxed) {
+            let asked = rt.requested_stiffness_gain.load(Ordering::Relaxed);
+            let got = rt.stiffness_gain.load(Ordering::Relaxed);
+            let (dz_asked, dz_got) = (
+                rt.requested_damping_gain.load(Ordering::Relaxed),
+                rt.damping_gain.load(Ordering::Relaxed),
+            );
+            let text = if got < asked * 0.9999 {
+                format!("Stiffness held at ×{got:.3} of ×{asked:.3}: stability limit")
+            } else {
+                format!("Damping held at ×{dz_got:.3} of ×{dz_asked:.3}: stability limit")
+            };
+            ui.colored_label(ORANGE, RichText::new(text).small());
+        }
+        row(ui, "Damping", &|ui| {
+            ui.add(ParamSlider::for_param(&p.damping, &setter));
+        });
+        row(ui, "Tune", &|ui| {
+            ui.add(ParamSlider::for_param(&p.tune, &setter));
+        });
+        row(ui, "Output", &|ui| {
+            ui.add(ParamSlider::for_param(&p.output_gain, &setter));
+        });
+        row(ui, "Force in", &|ui| {
+            ui.add(ParamSlider::for_param(&p.force_gain, &setter));
+        });
+        row(ui, "Position in", &|ui| {
+            ui.add(ParamSlider::for_param(&p.position_gain, &setter));
+        });
+        let mut dc = p.dc_filter.value();
+        if ui
+            .checkbox(&mut dc, "DC filter (40 Hz high-pass)")
+            .changed()
+        {
+            setter.begin_set_parameter(&p.dc_filter);
+            setter.set_parameter(&p.dc_filter, dc);
+            setter.end_set_parameter(&p.dc_filter);
+        }
+        ui.horizontal(|ui| {
+            if ui
+                .button("Strike")
+                .on_hover_text("Strike the note input once, like a MIDI note at velocity 0.8")
+                .clicked()
+            {
+                rt.strike_requested.store(true, Ordering::Release);
+            }
+            let mut audition = rt.audition.load(Ordering::Relaxed);
+            if ui
+                .checkbox(&mut audition, "Audition")
+                .on_hover_text("Strike the note input every second")
+                .changed()
+            {
+                rt.audition.store(audition, Ordering::Release);
+            }
+        });
+
+        ui.separator();
+        ui.heading("Macros");
+        let bound: Vec<_> = status
+            .summary
+            .macros
+            .iter()
+            .take(NUM_MACROS)
+            .enumerate()
+            .filter_map(|(i, b)| b.as_ref().map(|b| (i, b)))
+            .collect();
+        if bound.is_empty() {
+            ui.label(
+                RichText::new("This model declares no param: the slots are unbound.")
+                    .color(Color32::GRAY),
+            );
+        }
+        for (i, b) in &bound {
+            ui.horizontal(|ui| {
+                ui.label(RichText::new(format!("{}", i + 1)).color(Color32::GRAY));
+                ui.label(RichText::new(&b.name).strong().monospace());
+                ui.label(
+                    RichText::new(format!(
+                        "{} … {}",
+                        crate::model::format_value(b.min),
+                        crate::model::format_value(b.max)
+                    ))
+                    .small()
+                    .color(Color32::GRAY),
+                );
+            });
+            ui.add(ParamSlider::for_param(&p.macros[*i].value, &setter));
+        }
+        let unbound = NUM_MACROS - bound.len();
+        if !bound.is_empty() && unbound > 0 {
+            ui.label(
+                RichText::new(format!("{unbound} more slots unbound"))
+                    .small()
+                    .color(Color32::GRAY),
+            );
+        }
+    }
+
+    fn model_status(&self, ui: &mut Ui, status: &ModelStatus) {
+        let s = &status.summary;
+        egui::CollapsingHeader::new("Stability")
+            .default_open(true)
+            .show(ui, |ui| {
+                if s.stability.is_empty() {
+                    ui.label("No mass is loaded.");
+                }
+                for (i, line) in s.stability.iter().enumerate() {
+                    let colour = if i == 0 && line.starts_with("closest") {
+                        ui.visuals().text_color()
+                    } else {
+                        ORANGE
+                    };
+                    ui.colored_label(colour, RichText::new(line).small());
+                }
+            });
+        egui::CollapsingHeader::new("Inputs and outputs")
+            .default_open(false)
+            .show(ui, |ui| {
+                for line in s.inputs.iter().chain(&s.outputs) {
+                    ui.label(RichText::new(line).small().monospace());
+                }
+                if !s.params.is_empty() {
+                    ui.label(
+                        RichText::new(format!("params: {}", s.params.join(", ")))
+                            .small()
+                            .monospace(),
+                    );
+                }
+            });
+    }
+
+    fn motion_panel(&mut self, ui: &mut Ui, dt: f32) {
+        let Some(reader) = self.reader.as_mut() else {
+            ui.centered_and_justified(|ui| {
+                ui.label("The motion view starts when the plugin processes audio.");
+            });
+            return;
+        };
+        let view = reader.view.clone();
+        ui.horizontal(|ui| {
+            let current = match self.plot.buffer {
+                Some(b) if b < view.named.len() => format!("buffer {}", view.named[b].name),
+                _ => format!("all points ({})", view.len()),
+            };
+            egui::ComboBox::from_id_salt("buffer")
+                .selected_text(current)
+                .show_ui(ui, |ui| {
+                    ui.selectable_value(
+                        &mut self.plot.buffer,
+                        None,
+                        format!("all points ({})", view.len()),
+                    );
+                    for (i, b) in view.named.iter().enumerate() {
+                        ui.selectable_value(
+                            &mut self.plot.buffer,
+                            Some(i),
+                            format!("buffer {} ({})", b.name, b.members.len()),
+                        );
+                    }
+                });
+            ui.add_enabled_ui(self.plot.planar(), |ui| {
+                egui::ComboBox::from_id_salt("zmode")
+                    .selected_text(self.plot.mode.name())
+                    .show_ui(ui, |ui| {
+                        for m in ZMode::ALL {
+                            ui.selectable_value(&mut self.plot.mode, m, m.name());
+                        }
+                    })
+                    .response
+                    .on_disabled_hover_text("1-D selections show z vertically");
+            });
+            ui.checkbox(&mut self.plot.hold, "Hold scale");
+        });
+        let frame = reader.latest();
+        let z = frame.z.clone();
+        self.plot.show(ui, &view, &z, dt);
+    }
+}
+
+impl NiceEguiApp for EditorApp {
+    fn build(
+        &mut self,
+        egui_ctx: egui::Context,
+        nice_gui_ctx: GuiContext,
+        _frame: &mut nice_plug_egui::Frame,
+    ) -> Result<(), nice_plug_egui::baseview::HandlerError> {
+        // egui is built without its default-fonts feature in nice-plug-egui: set them here so
+        // text renders (this crate enables the feature).
+        egui_ctx.set_fonts(egui::FontDefinitions::default());
+        egui_ctx.set_visuals(egui::Visuals::dark());
+        self.gui = Some(nice_gui_ctx);
+        self.last_frame = None;
+        Ok(())
+    }
+
+    fn ui(&mut self, ui: &mut Ui, _frame: &mut nice_plug_egui::Frame) {
+        let now = Instant::now();
+        let dt = self
+            .last_frame
+            .map(|t| (now - t).as_secs_f32())
+            .unwrap_or(1.0 / 60.0)
+            .clamp(1e-4, 1.0);
+        self.last_frame = Some(now);
+        self.frame_times[self.frame_count % self.frame_times.len()] = dt;
+        self.frame_count += 1;
+        if let Some(r) = self.store.take_motion_reader() {
+            self.reader = Some(r);
+        }
+        self.store.collect_garbage();
+        self.sync_script();
+        let status = self.store.status();
+
+        egui::Panel::top("top").show(ui, |ui| {
+            ui.add_space(2.0);
+            self.top_bar(ui, &status);
+            ui.add_space(2.0);
+        });
+        egui::Panel::left("model")
+            .default_size(380.0)
+            .size_range(280.0..=700.0)
+            .show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    ui.selectable_value(&mut self.tab, Tab::Presets, "Presets");
+                    ui.selectable_value(&mut self.tab, Tab::Script, "Script");
+                    ui.selectable_value(&mut self.tab, Tab::File, "Open file");
+                });
+                if let Some((text, colour)) = &self.message {
+                    ui.colored_label(*colour, text);
+                }
+                ui.separator();
+                match self.tab {
+                    Tab::Presets => self.presets_tab(ui),
+                    Tab::Script => self.script_tab(ui, &status),
+                    Tab::File => self.file_tab(ui),
+                }
+            });
+        egui::Panel::right("controls")
+            .default_size(300.0)
+            .size_range(240.0..=480.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical()
+                    .id_salt("controls")
+                    .show(ui, |ui| {
+                        self.controls(ui, &status);
+                        ui.separator();
+                        self.model_status(ui, &status);
+                    });
+            });
+        egui::CentralPanel::default_margins().show(ui, |ui| self.motion_panel(ui, dt));
+        // Redraw continuously while open: the window system paces the frames.
+        ui.ctx().request_repaint();
+    }
+
+    fn editor_closed(&mut self) {
+        self.gui = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn diagnostics_split_into_position_and_message() {
+        assert_eq!(
+            Diagnostic::parse("12:4: error: undefined element `@x`"),
+            Diagnostic {
+                line: 12,
+                col: 4,
+                text: "error: undefined element `@x`".into()
+            }
+        );
+        assert_eq!(Diagnostic::parse("odd").line, 1);
+    }
+
+    #[test]
+    fn the_script_editor_follows_the_running_model_unless_edited() {
+        let store = Arc::new(ModelStore::default());
+        let params = Arc::new(RessortParams::new(store.clone()));
+        let mut app = EditorApp::new(params, store.clone());
+        let hammer = Preset::find("hammer-oscillator").unwrap();
+        store
+            .submit(ModelState {
+                name: hammer.id.into(),
+                script: hammer.text.into(),
+            })
+            .unwrap();
+        app.sync_script();
+        assert_eq!(app.script, hammer.text);
+        app.script.push_str("\n# my edit\n");
+        let harmonic = Preset::find("harmonic-oscillator").unwrap();
+        store
+            .submit(ModelState {
+                name: harmonic.id.into(),
+                script: harmonic.text.into(),
+            })
+            .unwrap();
+        app.sync_script();
+        assert!(app.script.ends_with("# my edit\n"), "edits are kept");
+        // A rejected script stays in the editor with its diagnostics; the model stays.
+        app.submit("bad".into(), "@m mass 1 0\n@x nothing".into());
+        assert_eq!(store.running().name, "harmonic-oscillator");
+        assert_eq!(app.tab, Tab::Script);
+        assert!(!store.status().diagnostics.is_empty());
+        assert!(app.script.contains("@x nothing"));
+    }
+}

@@ -1,0 +1,102 @@
+//! `ressort-screenshot`: starts `ressort-standalone` with a model under a private Xvfb,
+//! captures the editor window as a PNG and says what the motion view shows.
+//!
+//! ```text
+//! ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest]
+//! ```
+//!
+//! By default the model is struck every second (`--audition`) and the capture is taken as soon
+//! as the motion view shows motion (within S seconds of the window appearing, default 20);
+//! `--at-rest` does not strike and captures two seconds after the motion view appears. Exit status 0 when the plot shows motion (or, with
+//! `--at-rest`, whatever it shows), 1 when it does not, 2 on errors.
+
+use ressort_tests::screen::{capture_standalone, shows_motion, standalone_path, Xvfb};
+use std::path::PathBuf;
+use std::time::Duration;
+
+fn main() {
+    let mut model = "mesh-25x20".to_string();
+    let mut out = None;
+    let mut standalone = standalone_path();
+    let mut seconds = 20.0;
+    let mut at_rest = false;
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        let mut value = |name: &str| {
+            args.next().unwrap_or_else(|| {
+                eprintln!("ressort-screenshot: {name} needs a value");
+                std::process::exit(2)
+            })
+        };
+        match a.as_str() {
+            "--model" => model = value("--model"),
+            "--out" => out = Some(PathBuf::from(value("--out"))),
+            "--standalone" => standalone = PathBuf::from(value("--standalone")),
+            "--seconds" => {
+                seconds = value("--seconds").parse().unwrap_or_else(|_| {
+                    eprintln!("ressort-screenshot: --seconds takes a number");
+                    std::process::exit(2)
+                })
+            }
+            "--at-rest" => at_rest = true,
+            _ => {
+                eprintln!(
+                    "usage: ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest]"
+                );
+                std::process::exit(2)
+            }
+        }
+    }
+    let out = out.unwrap_or_else(|| {
+        PathBuf::from(format!(
+            "target/screenshots/editor-{}{}.png",
+            model.replace(['/', '.'], "_"),
+            if at_rest { "-at-rest" } else { "" }
+        ))
+    });
+    let Some(x) = Xvfb::start(1280, 800) else {
+        eprintln!("ressort-screenshot: Xvfb could not be started (is the xvfb package installed?)");
+        std::process::exit(2)
+    };
+    let capture = match capture_standalone(
+        &standalone,
+        x.display(),
+        &model,
+        !at_rest,
+        !at_rest,
+        Duration::from_secs_f64(seconds),
+    ) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("ressort-screenshot: {e}");
+            std::process::exit(2)
+        }
+    };
+    if let Err(e) = capture.image.save_png(&out) {
+        eprintln!("ressort-screenshot: {e}");
+        std::process::exit(2)
+    }
+    println!(
+        "wrote {} ({}×{}, {:.1} s after launch)",
+        out.display(),
+        capture.image.width,
+        capture.image.height,
+        capture.after_s
+    );
+    match &capture.stats {
+        Some(s) => println!("{s}"),
+        None => println!("no motion view found in the capture"),
+    }
+    let moving = capture.stats.as_ref().is_some_and(shows_motion);
+    println!(
+        "motion view: {}",
+        if moving {
+            "shows motion"
+        } else {
+            "blank or at rest"
+        }
+    );
+    if !moving && !at_rest {
+        std::process::exit(1)
+    }
+}
