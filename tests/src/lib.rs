@@ -30,6 +30,9 @@ use clack_extensions::audio_ports::{
 use clack_extensions::audio_ports_config::{
     AudioPortsConfigBuffer, HostAudioPortsConfig, HostAudioPortsConfigImpl, PluginAudioPortsConfig,
 };
+use clack_extensions::gui::{
+    GuiApiType, GuiConfiguration, GuiSize, HostGui, HostGuiImpl, PluginGui, Window,
+};
 use clack_extensions::log::{HostLog, HostLogImpl, LogSeverity};
 use clack_extensions::note_ports::{
     HostNotePorts, HostNotePortsImpl, NoteDialects, NotePortInfoBuffer, NotePortRescanFlags,
@@ -43,6 +46,7 @@ use clack_extensions::state::{HostState, HostStateImpl, PluginState, StateError}
 use clack_extensions::thread_check::{HostThreadCheck, HostThreadCheckImpl};
 use clack_host::events::event_types::{MidiEvent, NoteOffEvent, NoteOnEvent, ParamValueEvent};
 use clack_host::events::Match;
+use clack_host::host::HostError;
 use clack_host::prelude::*;
 use std::cell::Cell;
 use std::fmt;
@@ -167,6 +171,26 @@ impl HostLogImpl for HostShared {
     }
 }
 
+/// The editor's requests to the host window (the test host accepts them; the editor tests
+/// drive sizes through `gui.set_size`).
+impl HostGuiImpl for HostShared {
+    fn resize_hints_changed(&self) {}
+
+    fn request_resize(&self, _new_size: GuiSize) -> Result<(), HostError> {
+        Ok(())
+    }
+
+    fn request_show(&self) -> Result<(), HostError> {
+        Ok(())
+    }
+
+    fn request_hide(&self) -> Result<(), HostError> {
+        Ok(())
+    }
+
+    fn closed(&self, _was_destroyed: bool) {}
+}
+
 impl HostParamsImplShared for HostShared {
     fn request_flush(&self) {
         self.flush_requested.store(true, Ordering::Release);
@@ -277,7 +301,8 @@ impl HostHandlers for TestHost {
             .register::<HostAudioPorts>()
             .register::<HostAudioPortsConfig>()
             .register::<HostNotePorts>()
-            .register::<HostThreadCheck>();
+            .register::<HostThreadCheck>()
+            .register::<HostGui>();
     }
 }
 
@@ -607,6 +632,7 @@ struct Extensions {
     audio_ports: Option<PluginAudioPorts>,
     audio_ports_config: Option<PluginAudioPortsConfig>,
     note_ports: Option<PluginNotePorts>,
+    gui: Option<PluginGui>,
 }
 
 /// Host-side buffers of an active plugin, allocated at activation.
@@ -685,6 +711,7 @@ impl TestPlugin {
             audio_ports: shared.get_extension(),
             audio_ports_config: shared.get_extension(),
             note_ports: shared.get_extension(),
+            gui: shared.get_extension(),
         };
         let mut plugin = TestPlugin {
             processor: None,
@@ -694,6 +721,53 @@ impl TestPlugin {
         };
         plugin.idle();
         plugin
+    }
+
+    /// Opens the plugin's editor embedded in the X11 window `parent` (CLAP gui extension:
+    /// `is_api_supported`, `create`, `set_scale`, `get_size`, `set_parent`, `show`), as a DAW
+    /// does on Linux. Returns the editor's size.
+    pub fn open_editor(&mut self, parent: u32) -> Result<(u32, u32), String> {
+        let gui = self.ext.gui.ok_or("the plugin has no gui extension")?;
+        let handle = self.instance.plugin_handle();
+        let config = GuiConfiguration {
+            api_type: GuiApiType::X11,
+            is_floating: false,
+        };
+        if !gui.is_api_supported(&handle, config) {
+            return Err("the plugin does not support embedded X11 editors".into());
+        }
+        gui.create(&handle, config)
+            .map_err(|e| format!("gui.create: {e:?}"))?;
+        let _ = gui.set_scale(&handle, 1.0);
+        let size = gui.get_size(&handle).ok_or("gui.get_size failed")?;
+        // SAFETY: `parent` is a live X11 window that outlives the editor (the caller destroys
+        // the editor with `close_editor` first).
+        unsafe { gui.set_parent(&handle, Window::from_x11_handle(parent as _)) }
+            .map_err(|e| format!("gui.set_parent: {e:?}"))?;
+        gui.show(&handle).map_err(|e| format!("gui.show: {e:?}"))?;
+        Ok((size.width, size.height))
+    }
+
+    /// Whether the editor can be resized, and its size after asking for `width` × `height`.
+    pub fn resize_editor(&mut self, width: u32, height: u32) -> Result<(bool, u32, u32), String> {
+        let gui = self.ext.gui.ok_or("the plugin has no gui extension")?;
+        let handle = self.instance.plugin_handle();
+        let can = gui.can_resize(&handle);
+        let asked = GuiSize { width, height };
+        let adjusted = gui.adjust_size(&handle, asked).unwrap_or(asked);
+        gui.set_size(&handle, adjusted)
+            .map_err(|e| format!("gui.set_size: {e:?}"))?;
+        let size = gui.get_size(&handle).ok_or("gui.get_size failed")?;
+        Ok((can, size.width, size.height))
+    }
+
+    /// Hides and destroys the editor.
+    pub fn close_editor(&mut self) {
+        if let Some(gui) = self.ext.gui {
+            let handle = self.instance.plugin_handle();
+            let _ = gui.hide(&handle);
+            gui.destroy(&handle);
+        }
     }
 
     /// The plugin's name from its descriptor.

@@ -386,3 +386,57 @@ pub fn capture_standalone(
     let _ = std::fs::remove_file(&log);
     result
 }
+
+/// A plain top-level window to embed an editor in, as a DAW's plugin window is. Kept open
+/// while the value lives.
+#[derive(Debug)]
+pub struct HostWindow {
+    conn: x11rb::rust_connection::RustConnection,
+    pub window: Window,
+}
+
+impl HostWindow {
+    /// Opens a `width` × `height` window called `title` on `display`.
+    pub fn open(display: &str, title: &str, width: u16, height: u16) -> Result<HostWindow, String> {
+        use x11rb::protocol::xproto::{CreateWindowAux, PropMode, WindowClass};
+        use x11rb::wrapper::ConnectionExt as _;
+        let (conn, screen) = x11rb::connect(Some(display)).map_err(|e| e.to_string())?;
+        let root = conn.setup().roots[screen].root;
+        let window = conn.generate_id().map_err(|e| e.to_string())?;
+        conn.create_window(
+            x11rb::COPY_DEPTH_FROM_PARENT,
+            window,
+            root,
+            0,
+            0,
+            width,
+            height,
+            0,
+            WindowClass::INPUT_OUTPUT,
+            x11rb::COPY_FROM_PARENT,
+            &CreateWindowAux::new().background_pixel(0),
+        )
+        .map_err(|e| e.to_string())?;
+        conn.change_property8(
+            PropMode::REPLACE,
+            window,
+            AtomEnum::WM_NAME,
+            AtomEnum::STRING,
+            title.as_bytes(),
+        )
+        .map_err(|e| e.to_string())?;
+        conn.map_window(window).map_err(|e| e.to_string())?;
+        conn.flush().map_err(|e| e.to_string())?;
+        Ok(HostWindow { conn, window })
+    }
+
+    /// The windows embedded in this one.
+    pub fn children(&self) -> Vec<Window> {
+        self.conn
+            .query_tree(self.window)
+            .ok()
+            .and_then(|c| c.reply().ok())
+            .map(|t| t.children)
+            .unwrap_or_default()
+    }
+}
