@@ -197,16 +197,22 @@ impl EditorApp {
             .iter()
             .position(|p| p.id == running.name)
             .unwrap_or(0);
+        // A script that failed to load (a project saved with a broken script, a bad
+        // `--model` file) opens in the script editor with its diagnostics.
+        let (script, script_name, tab) = match store.status().rejected {
+            Some(r) => (r.script, r.name, Tab::Script),
+            None => (running.script.clone(), running.name.clone(), Tab::Presets),
+        };
         EditorApp {
             params,
-            script: running.script.clone(),
-            script_name: running.name.clone(),
+            script,
+            script_name,
             synced: running,
             store,
             gui: None,
             reader: None,
             plot: PlotState::default(),
-            tab: Tab::Presets,
+            tab,
             preset,
             message: None,
             browser: FileBrowser::new(),
@@ -851,5 +857,26 @@ mod tests {
         assert_eq!(app.tab, Tab::Script);
         assert!(!store.status().diagnostics.is_empty());
         assert!(app.script.contains("@x nothing"));
+    }
+
+    #[test]
+    fn a_script_that_failed_to_load_opens_in_the_script_editor() {
+        let store = Arc::new(ModelStore::default());
+        let params = Arc::new(RessortParams::new(store.clone()));
+        let bad = "@m mass 1 0 0\n@s spring @m @nowhere 0.1\n";
+        assert!(store
+            .submit(ModelState {
+                name: "broken".into(),
+                script: bad.into(),
+            })
+            .is_err());
+        let app = EditorApp::new(params, store.clone());
+        assert_eq!((app.tab, app.script.as_str()), (Tab::Script, bad));
+        assert_eq!(
+            Diagnostic::parse(&store.status().diagnostics[0]).line,
+            2,
+            "the diagnostic points at the line the editor highlights"
+        );
+        assert_eq!(store.running().name, crate::presets::DEFAULT_PRESET);
     }
 }
