@@ -104,49 +104,44 @@ impl Image {
     }
 }
 
-/// The first window (depth first from the root) whose name is `name`.
-pub fn find_window(display: &str, name: &str) -> Option<Window> {
-    let (conn, screen) = x11rb::connect(Some(display)).ok()?;
-    let root = conn.setup().roots[screen].root;
-    let mut stack = vec![root];
+/// Every window of the display with its name (empty when it has none), depth first from the
+/// root.
+fn windows(display: &str) -> Vec<(Window, String)> {
+    let Ok((conn, screen)) = x11rb::connect(Some(display)) else {
+        return Vec::new();
+    };
+    let mut found = Vec::new();
+    let mut stack = vec![conn.setup().roots[screen].root];
     while let Some(w) = stack.pop() {
-        let title = conn
+        let name = conn
             .get_property(false, w, AtomEnum::WM_NAME, AtomEnum::ANY, 0, 256)
             .ok()
             .and_then(|c| c.reply().ok())
-            .map(|r| String::from_utf8_lossy(&r.value).into_owned());
-        if title.as_deref() == Some(name) {
-            return Some(w);
-        }
+            .map(|r| String::from_utf8_lossy(&r.value).into_owned())
+            .unwrap_or_default();
+        found.push((w, name));
         if let Some(tree) = conn.query_tree(w).ok().and_then(|c| c.reply().ok()) {
             stack.extend(tree.children.iter().rev());
         }
     }
-    None
+    found
+}
+
+/// The first window (depth first from the root) whose name is `name`.
+pub fn find_window(display: &str, name: &str) -> Option<Window> {
+    windows(display)
+        .into_iter()
+        .find(|(_, n)| n == name)
+        .map(|(w, _)| w)
 }
 
 /// Every window name on the display, for error messages.
 pub fn window_names(display: &str) -> Vec<String> {
-    let Ok((conn, screen)) = x11rb::connect(Some(display)) else {
-        return Vec::new();
-    };
-    let mut names = Vec::new();
-    let mut stack = vec![conn.setup().roots[screen].root];
-    while let Some(w) = stack.pop() {
-        if let Some(r) = conn
-            .get_property(false, w, AtomEnum::WM_NAME, AtomEnum::ANY, 0, 256)
-            .ok()
-            .and_then(|c| c.reply().ok())
-        {
-            if !r.value.is_empty() {
-                names.push(String::from_utf8_lossy(&r.value).into_owned());
-            }
-        }
-        if let Some(tree) = conn.query_tree(w).ok().and_then(|c| c.reply().ok()) {
-            stack.extend(tree.children);
-        }
-    }
-    names
+    windows(display)
+        .into_iter()
+        .map(|(_, n)| n)
+        .filter(|n| !n.is_empty())
+        .collect()
 }
 
 /// Captures a window's contents (a 24-bit TrueColor window, as Xvfb and baseview make).
