@@ -693,7 +693,7 @@ impl EditorApp {
         let view = reader.view.clone();
         ui.horizontal(|ui| {
             let current = match self.plot.buffer {
-                Some(b) if b < view.named.len() => format!("buffer {}", view.named[b].name),
+                Some(b) if b < view.named().len() => format!("buffer {}", view.named()[b].name),
                 _ => format!("all points ({})", view.len()),
             };
             egui::ComboBox::from_id_salt("buffer")
@@ -704,7 +704,7 @@ impl EditorApp {
                         None,
                         format!("all points ({})", view.len()),
                     );
-                    for (i, b) in view.named.iter().enumerate() {
+                    for (i, b) in view.named().iter().enumerate() {
                         ui.selectable_value(
                             &mut self.plot.buffer,
                             Some(i),
@@ -725,9 +725,7 @@ impl EditorApp {
             });
             ui.checkbox(&mut self.plot.hold, "Hold scale");
         });
-        let frame = reader.latest();
-        let z = frame.z.clone();
-        self.plot.show(ui, &view, &z, dt);
+        self.plot.show(ui, &view, &reader.latest().z, dt);
     }
 }
 

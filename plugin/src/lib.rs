@@ -420,12 +420,19 @@ impl Ressort {
 
     /// The editor's requests: reset the model, strike it once or repeatedly. Realtime-safe.
     fn editor_requests(&mut self) {
-        let store = self.store.clone();
-        let rt = &store.runtime;
-        if rt.reset_requested.swap(false, Ordering::AcqRel) {
-            rt.guard_active.store(false, Ordering::Release);
+        if self
+            .store
+            .runtime
+            .reset_requested
+            .swap(false, Ordering::AcqRel)
+        {
+            self.store
+                .runtime
+                .guard_active
+                .store(false, Ordering::Release);
             self.restart_model();
         }
+        let rt = &self.store.runtime;
         let mut strike = rt.strike_requested.swap(false, Ordering::AcqRel);
         if rt.audition.load(Ordering::Acquire) {
             if self.audition_left == 0 {

@@ -8,8 +8,7 @@
 //! buffer at most [`MOTION_FRAME_RATE`] times per second: a copy of every point's z into a
 //! preallocated frame and a publish, no allocation and no lock.
 
-use ressort_engine::info::OwnerInfo;
-use ressort_engine::{Engine, IoPoint, NamedBuffer, PointInfo, PointKind};
+use ressort_engine::{Engine, IoPoint, ModelInfo, NamedBuffer, PointKind};
 use std::sync::Arc;
 use triple_buffer::{Input, Output};
 
@@ -45,9 +44,8 @@ pub struct MotionView {
     pub y: Vec<f32>,
     /// Every point's position at rest: the view shows the motion around it.
     pub rest: Vec<f32>,
-    pub points: Vec<PointInfo>,
-    pub owners: Vec<OwnerInfo>,
-    pub named: Vec<NamedBuffer>,
+    /// The model's metadata: points, owners, named buffers (`info.motion.named`).
+    pub info: ModelInfo,
     pub io: Vec<IoPoint>,
     /// Explicit interactions as point pairs.
     pub links: Vec<(u32, u32)>,
@@ -84,9 +82,7 @@ impl MotionView {
                 .iter()
                 .map(|&v| v as f32)
                 .collect(),
-            points: info.points.clone(),
-            owners: info.owners.clone(),
-            named: info.motion.named.clone(),
+            info: info.clone(),
             io: engine.io_points(),
             links: engine.links(),
             macros,
@@ -95,28 +91,24 @@ impl MotionView {
 
     /// The number of points of the generic buffer.
     pub fn len(&self) -> usize {
-        self.points.len()
+        self.info.points.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
+        self.info.points.is_empty()
     }
 
-    /// A readable name for point `i`: `m1`, `s[12]`, `mesh[3,4]`.
+    /// The named buffers (spec §6.3).
+    pub fn named(&self) -> &[NamedBuffer] {
+        &self.info.motion.named
+    }
+
+    /// A readable name for point `i`: `@m1`, `@s[12]`, `@mesh[3,4]`.
     pub fn label(&self, i: usize) -> String {
-        let Some(p) = self.points.get(i) else {
-            return String::new();
-        };
-        let owner = &self.owners[p.owner as usize];
-        match p.kind {
-            PointKind::MacroNode { .. } if owner.mesh_width > 0 => format!(
-                "@{}[{},{}]",
-                owner.label,
-                p.node / owner.mesh_width,
-                p.node % owner.mesh_width
-            ),
-            PointKind::MacroNode { .. } => format!("@{}[{}]", owner.label, p.node),
-            _ => format!("@{}", owner.label),
+        if i < self.len() {
+            format!("@{}", self.info.point_label(i))
+        } else {
+            String::new()
         }
     }
 }

@@ -103,11 +103,11 @@ impl PlotState {
         if self.selection_key == Some(key) {
             return;
         }
-        if self.buffer.is_some_and(|b| b >= view.named.len()) {
+        if self.buffer.is_some_and(|b| b >= view.named().len()) {
             self.buffer = None;
         }
         self.selection = match self.buffer {
-            Some(b) => view.named[b]
+            Some(b) => view.named()[b]
                 .members
                 .iter()
                 .copied()
@@ -319,7 +319,7 @@ impl PlotState {
         // Runs of consecutive points that belong together: nodes of one macro, or single
         // elements in a row.
         let joined = |a: u32, b: u32| {
-            let (pa, pb) = (&view.points[a as usize], &view.points[b as usize]);
+            let (pa, pb) = (&view.info.points[a as usize], &view.info.points[b as usize]);
             let is_node =
                 |p: &ressort_engine::PointInfo| matches!(p.kind, PointKind::MacroNode { .. });
             b == a + 1 && (pa.owner == pb.owner || !(is_node(pa) || is_node(pb)))
