@@ -43,5 +43,6 @@ pub use motion::{MotionLayout, MotionStore, NamedBuffer};
 pub use spec::{
     Element, ElementKind, Endpoint, HostSpec, Law, MacroKind, MacroRange, MacroSpec, ModelBuilder,
     ModelSpec, ParamDecl, ParamKind, Route, RouteSource, SampleRateMode, ScaleClass, Span, Vector,
+    REFERENCE_SAMPLE_RATE_HZ,
 };
 pub use stability::{MassStability, StabilityReport, StabilityWarning};

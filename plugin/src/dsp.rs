@@ -55,31 +55,48 @@ pub fn db_to_gain(db: f64) -> f64 {
     10f64.powf(db / 20.0)
 }
 
-/// A one-pole smoother advanced once per chunk of `chunk` samples.
+/// A one-pole smoother advanced once per chunk: by a full chunk of `chunk` samples on the
+/// chunk grid, or by the shorter span to the next grid point when automation starts a chunk
+/// between grid points.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ChunkSmoother {
     pub value: f64,
+    /// Time constant in samples.
+    tau: f64,
+    chunk: usize,
+    /// Coefficient of a full chunk.
     coefficient: f64,
 }
 
 impl ChunkSmoother {
     /// `time_ms` is the time constant.
     pub fn new(sample_rate: f64, chunk: usize, time_ms: f64, value: f64) -> ChunkSmoother {
-        let samples = (time_ms * 1e-3 * sample_rate).max(1.0);
+        let tau = (time_ms * 1e-3 * sample_rate).max(1.0);
         ChunkSmoother {
             value,
-            coefficient: 1.0 - (-(chunk as f64) / samples).exp(),
+            tau,
+            chunk,
+            coefficient: 1.0 - (-(chunk as f64) / tau).exp(),
         }
     }
 
-    /// Moves towards `target`; snaps when within a relative 1e-9 so the value settles.
+    /// Moves towards `target` by a full chunk.
     #[inline]
     pub fn next(&mut self, target: f64) -> f64 {
+        self.advance(self.chunk, target)
+    }
+
+    /// Moves towards `target` by `samples`; snaps when within a relative 1e-9 so the value
+    /// settles.
+    #[inline]
+    pub fn advance(&mut self, samples: usize, target: f64) -> f64 {
         let d = target - self.value;
         if d.abs() <= 1e-9 * target.abs().max(1e-12) {
             self.value = target;
-        } else {
+        } else if samples == self.chunk {
             self.value += self.coefficient * d;
+        } else {
+            self.value += (1.0 - (-(samples as f64) / self.tau).exp()) * d;
         }
         self.value
     }
@@ -142,6 +159,24 @@ mod tests {
             }
         }
         assert!((peak - 1.0).abs() < 0.01, "1 kHz passes at {peak}");
+    }
+
+    #[test]
+    fn smoother_steps_compose_whatever_their_length() {
+        // Two half chunks land where one full chunk does: a chunk cut by automation keeps
+        // the smoothing time.
+        let mut full = ChunkSmoother::new(48_000.0, 16, 15.0, 0.0);
+        let mut halves = full;
+        full.next(1.0);
+        halves.advance(8, 1.0);
+        halves.advance(8, 1.0);
+        assert!((full.value - halves.value).abs() < 1e-15, "{} {}", full.value, halves.value);
+        // 15 ms is 720 samples at 48 kHz: after 720 samples, 1 − 1/e of the way.
+        let mut s = ChunkSmoother::new(48_000.0, 16, 15.0, 0.0);
+        for _ in 0..45 {
+            s.next(1.0);
+        }
+        assert!((s.value - (1.0 - (-1f64).exp())).abs() < 1e-12, "{}", s.value);
     }
 
     #[test]

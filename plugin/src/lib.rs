@@ -40,6 +40,8 @@ const QUIET_LEVEL: f64 = 1e-6;
 const CONTROL_SMOOTHING_MS: f64 = 15.0;
 /// Smoothing time constant of the gains.
 const GAIN_SMOOTHING_MS: f64 = 5.0;
+/// Stiffness, Damping, Tune, the three gains and the macros.
+const CONTROL_COUNT: usize = 6 + NUM_MACROS;
 /// Interval of the editor's repeated strike (Audition).
 const AUDITION_INTERVAL_S: f64 = 1.0;
 /// Velocity of the editor's strikes.
@@ -70,8 +72,15 @@ pub struct Ressort {
     position_gain: ChunkSmoother,
     output_gain: ChunkSmoother,
     macros: [ChunkSmoother; NUM_MACROS],
-    /// Output gain at the end of the previous chunk: the per-sample ramp starts there.
+    /// Output gain where the current chunk's per-sample ramp starts.
     last_output_gain: f64,
+    /// Length of the current chunk and the samples of it already rendered. A chunk runs to
+    /// the next multiple of CHUNK (counted from activation), so the sound does not depend
+    /// on the host's block size; automation starts a new chunk at its own sample.
+    chunk_len: usize,
+    chunk_done: usize,
+    /// The parameter values the smoothers were last given, to notice automation.
+    last_targets: [f32; CONTROL_COUNT],
     dc: [DcBlocker; 2],
     /// Fade-in after a guard reset: current gain and step per sample.
     guard_gain: f64,
@@ -138,6 +147,9 @@ impl Default for Ressort {
             output_gain: ChunkSmoother::default(),
             macros: [ChunkSmoother::default(); NUM_MACROS],
             last_output_gain: 0.0,
+            chunk_len: 0,
+            chunk_done: 0,
+            last_targets: [0.0; CONTROL_COUNT],
             dc: [DcBlocker::default(); 2],
             guard_gain: 1.0,
             guard_step: 0.0,
@@ -197,6 +209,9 @@ impl Ressort {
         self.guard_gain = 1.0;
         self.guard_step = 0.0;
         self.counter = 0;
+        self.chunk_len = 0;
+        self.chunk_done = 0;
+        self.last_targets = self.targets();
         self.quiet_samples = 0;
         self.pending_event = None;
     }
@@ -244,31 +259,48 @@ impl Ressort {
             .running_generation
             .fetch_add(1, Ordering::AcqRel);
         // The new model's gains and macros are set before its first sample.
-        self.apply_controls(false);
+        self.apply_controls(None);
     }
 
-    /// Advances the control smoothers (when `advance`) and applies the gains and macros to
-    /// the running model, clamped by its stability envelope.
-    fn apply_controls(&mut self, advance: bool) {
+    /// The current values of the smoothed parameters.
+    fn targets(&self) -> [f32; CONTROL_COUNT] {
         let p = &self.params;
-        let (st, dz, tune) = if advance {
-            (
-                self.stiffness.next(p.stiffness.value() as f64),
-                self.damping.next(p.damping.value() as f64),
-                self.tune.next(p.tune.value() as f64 + self.bend_semitones),
-            )
-        } else {
-            (self.stiffness.value, self.damping.value, self.tune.value)
+        let mut t = [0.0; CONTROL_COUNT];
+        t[0] = p.stiffness.value();
+        t[1] = p.damping.value();
+        t[2] = p.tune.value();
+        t[3] = p.force_gain.value();
+        t[4] = p.position_gain.value();
+        t[5] = p.output_gain.value();
+        for (v, m) in t[6..].iter_mut().zip(&p.macros) {
+            *v = m.value.value();
+        }
+        t
+    }
+
+    /// Advances the control smoothers by `advance` samples (the length of the chunk that
+    /// starts) and applies the gains and macros to the running model, clamped by its
+    /// stability envelope.
+    fn apply_controls(&mut self, advance: Option<usize>) {
+        let p = &self.params;
+        let (st, dz, tune) = match advance {
+            Some(n) => (
+                self.stiffness.advance(n, p.stiffness.value() as f64),
+                self.damping.advance(n, p.damping.value() as f64),
+                self.tune
+                    .advance(n, p.tune.value() as f64 + self.bend_semitones),
+            ),
+            None => (self.stiffness.value, self.damping.value, self.tune.value),
         };
-        if advance {
+        if let Some(n) = advance {
             self.force_gain
-                .next(db_to_gain(p.force_gain.value() as f64));
+                .advance(n, db_to_gain(p.force_gain.value() as f64));
             self.position_gain
-                .next(db_to_gain(p.position_gain.value() as f64));
+                .advance(n, db_to_gain(p.position_gain.value() as f64));
             self.output_gain
-                .next(db_to_gain(p.output_gain.value() as f64));
+                .advance(n, db_to_gain(p.output_gain.value() as f64));
             for (s, m) in self.macros.iter_mut().zip(&p.macros) {
-                s.next(m.value.value() as f64);
+                s.advance(n, m.value.value() as f64);
             }
         }
         let Some(model) = self.current.as_mut() else {
@@ -359,6 +391,7 @@ impl Ressort {
                     retuned = true;
                     if let Some(k) = model.note_input {
                         let force = model.settings.note_force
+                            * model.strike_scale
                             * velocity.clamp(0.0, 1.0) as f64
                             * self.force_gain.value;
                         model.inputs[k * len + frame] += force;
@@ -390,7 +423,7 @@ impl Ressort {
         for (k, role) in model.roles.iter().enumerate() {
             let source = model.routing[k].or_else(|| order.get(k).copied());
             let gain = match role {
-                InputRole::Force => force,
+                InputRole::Force => force * model.force_scale,
                 InputRole::Position => position,
                 InputRole::AudioParam => 1.0,
                 InputRole::Unused => 0.0,
@@ -546,7 +579,7 @@ impl Plugin for Ressort {
             return false;
         }
         self.snap_controls();
-        self.apply_controls(false);
+        self.apply_controls(None);
         true
     }
 
@@ -561,7 +594,7 @@ impl Plugin for Ressort {
         self.note_semitones = 0.0;
         self.bend_semitones = 0.0;
         self.snap_controls();
-        self.apply_controls(false);
+        self.apply_controls(None);
     }
 
     fn deactivate(&mut self) {
@@ -583,11 +616,28 @@ impl Plugin for Ressort {
         let editor_open = self.editor_state.is_open();
         let frames = buffer.samples();
         let order = host::default_order(self.has_main_input);
+        // nice-plug starts a process() call at every automation event (sample-accurate
+        // automation), so a changed parameter starts a new chunk exactly at its sample.
+        let targets = self.targets();
+        let mut automated = targets != self.last_targets;
+        self.last_targets = targets;
         let mut loudest: f64 = 0.0;
         let mut pos = 0;
         while pos < frames {
-            let phase = (self.counter % CHUNK as u64) as usize;
-            let len = (CHUNK - phase).min(frames - pos);
+            if self.chunk_done >= self.chunk_len || automated {
+                automated = false;
+                // The output gain ramp of a cut chunk continues from where it got to.
+                if self.chunk_len > 0 {
+                    let g1 = self.output_gain.value;
+                    self.last_output_gain +=
+                        (g1 - self.last_output_gain) * self.chunk_done as f64 / self.chunk_len as f64;
+                }
+                // To the next grid point: chunks realign to multiples of CHUNK.
+                self.chunk_len = CHUNK - (self.counter % CHUNK as u64) as usize;
+                self.chunk_done = 0;
+                self.apply_controls(Some(self.chunk_len));
+            }
+            let len = (self.chunk_len - self.chunk_done).min(frames - pos);
 
             // Host channels for this chunk: main input (in place in `buffer`), sidechain.
             for row in self.host_in.iter_mut() {
@@ -609,22 +659,21 @@ impl Plugin for Ressort {
                 }
             }
 
-            if phase == 0 {
-                self.apply_controls(true);
-            }
             let (force, position) = (self.force_gain.value, self.position_gain.value);
             if let Some(model) = self.current.as_mut() {
                 Self::fill_inputs(model, &self.host_in, order, len, force, position);
             }
             if self.handle_events(context, pos, len) {
-                self.apply_controls(false);
+                self.apply_controls(None);
             }
             if self.pending_strike {
                 self.pending_strike = false;
                 if let Some(model) = self.current.as_mut() {
                     if let Some(k) = model.note_input {
-                        model.inputs[k * len] +=
-                            model.settings.note_force * AUDITION_VELOCITY * force;
+                        model.inputs[k * len] += model.settings.note_force
+                            * model.strike_scale
+                            * AUDITION_VELOCITY
+                            * force;
                     }
                 }
             }
@@ -655,10 +704,10 @@ impl Plugin for Ressort {
                 );
             }
 
-            // Output stage.
+            // Output stage: the gain ramps across the chunk, whatever the host's blocks.
             let g0 = self.last_output_gain;
             let g1 = self.output_gain.value;
-            self.last_output_gain = g1;
+            let (done, chunk_len) = (self.chunk_done as f64, self.chunk_len as f64);
             let dc_on = self.params.dc_filter.value();
             let out = buffer.as_slice();
             for i in 0..len {
@@ -684,7 +733,7 @@ impl Plugin for Ressort {
                     }
                     self.fade_left -= 1;
                 }
-                let g = g0 + (g1 - g0) * (i + 1) as f64 / len as f64;
+                let g = g0 + (g1 - g0) * (done + (i + 1) as f64) / chunk_len;
                 l *= g;
                 r *= g;
                 if dc_on {
@@ -724,6 +773,10 @@ impl Plugin for Ressort {
             }
             pos += len;
             self.counter += len as u64;
+            self.chunk_done += len;
+            if self.chunk_done >= self.chunk_len {
+                self.last_output_gain = g1;
+            }
         }
         let rt = &self.store.runtime;
         let seconds = frames as f64 / self.sample_rate;

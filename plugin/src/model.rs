@@ -14,7 +14,8 @@ use crate::runtime::RuntimeStatus;
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::params::persist::PersistentField;
 use ressort_engine::{
-    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, ParamId, RouteSource, ScaleClass,
+    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, ParamId, RouteSource,
+    SampleRateMode, ScaleClass, REFERENCE_SAMPLE_RATE_HZ,
 };
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -220,6 +221,13 @@ pub struct Prepared {
     pub rest: Vec<f64>,
     /// The model input a MIDI note strikes (0-based), if it exists.
     pub note_input: Option<usize>,
+    /// Force inputs are read "as at 44.1 kHz", like the script's parameters: a force signal
+    /// is scaled by (44100/SR)², the class of gravity (spec §1.7), so a sidechain moves the
+    /// model the same at any sample rate. 1 in `~samplerate raw` scripts.
+    pub force_scale: f64,
+    /// A one-sample strike (MIDI note, editor) is scaled by 44100/SR so that it gives the
+    /// model the same momentum at any sample rate. 1 in `~samplerate raw` scripts.
+    pub strike_scale: f64,
     pub macros: Vec<Option<MacroBinding>>,
     pub envelope: StabilityEnvelope,
     /// Per macro slot: the envelopes with its param at the range's minimum and maximum (the
@@ -362,6 +370,10 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
         })
         .collect();
 
+    let rate = match spec.sample_rate_mode {
+        SampleRateMode::Scaled => REFERENCE_SAMPLE_RATE_HZ / sample_rate,
+        SampleRateMode::Raw => 1.0,
+    };
     let num_outputs = info.num_outputs();
     let (motion, motion_reader) = motion_channel(&engine, sample_rate);
     Ok(Prepared {
@@ -374,6 +386,8 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
         routing,
         rest,
         note_input,
+        force_scale: rate * rate,
+        strike_scale: rate,
         macros,
         envelope,
         macro_envelopes,

@@ -1484,6 +1484,40 @@ pub fn peak_frequency(signal: &[f32], sample_rate: f64, lo_hz: f64, hi_hz: f64) 
     (k as f64 + delta) * bin_hz
 }
 
+/// The share of a signal's energy between `lo_hz` and `hi_hz` (mean removed, Hann window):
+/// 1 when all of it lies in the band.
+pub fn band_energy_share(signal: &[f32], sample_rate: f64, lo_hz: f64, hi_hz: f64) -> f64 {
+    use realfft::RealFftPlanner;
+    let n = signal.len();
+    assert!(n >= 16, "too short for a spectrum: {n} samples");
+    let mean = signal.iter().map(|&v| v as f64).sum::<f64>() / n as f64;
+    let mut buf: Vec<f64> = signal
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos();
+            (v as f64 - mean) * w
+        })
+        .collect();
+    let fft = RealFftPlanner::<f64>::new().plan_fft_forward(n);
+    let mut spectrum = fft.make_output_vec();
+    fft.process(&mut buf, &mut spectrum).expect("FFT");
+    let bin_hz = sample_rate / n as f64;
+    let power: Vec<f64> = spectrum.iter().map(|c| c.norm_sqr()).collect();
+    let total: f64 = power.iter().sum();
+    let band: f64 = power
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| (lo_hz..=hi_hz).contains(&(*k as f64 * bin_hz)))
+        .map(|(_, p)| p)
+        .sum();
+    if total > 0.0 {
+        band / total
+    } else {
+        0.0
+    }
+}
+
 /// The interval from `b` to `a` in cents.
 pub fn cents(a: f64, b: f64) -> f64 {
     1200.0 * (a / b).log2()
