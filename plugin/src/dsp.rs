@@ -170,13 +170,22 @@ mod tests {
         full.next(1.0);
         halves.advance(8, 1.0);
         halves.advance(8, 1.0);
-        assert!((full.value - halves.value).abs() < 1e-15, "{} {}", full.value, halves.value);
+        assert!(
+            (full.value - halves.value).abs() < 1e-15,
+            "{} {}",
+            full.value,
+            halves.value
+        );
         // 15 ms is 720 samples at 48 kHz: after 720 samples, 1 − 1/e of the way.
         let mut s = ChunkSmoother::new(48_000.0, 16, 15.0, 0.0);
         for _ in 0..45 {
             s.next(1.0);
         }
-        assert!((s.value - (1.0 - (-1f64).exp())).abs() < 1e-12, "{}", s.value);
+        assert!(
+            (s.value - (1.0 - (-1f64).exp())).abs() < 1e-12,
+            "{}",
+            s.value
+        );
     }
 
     #[test]

@@ -12,6 +12,7 @@ use crate::motion::MotionReader;
 use crate::params::RessortParams;
 use crate::plot::{PlotState, ZMode};
 use crate::presets::{Preset, PRESETS};
+use crate::report::{set_guard_with, HostLink};
 use egui::{Color32, RichText, Ui};
 use nice_plug::context::gui::GuiContext;
 use nice_plug::editor::dpi::LogicalSize;
@@ -46,6 +47,7 @@ pub fn create(
     params: Arc<RessortParams>,
     store: Arc<ModelStore>,
     state: Arc<EguiEditorState>,
+    link: Arc<HostLink>,
 ) -> Option<EguiEditor<EditorApp>> {
     let settings = EguiNiceSettings::new()
         .with_tile("Ressort")
@@ -60,7 +62,7 @@ pub fn create(
         state,
         RepaintNotifier::new(),
         settings,
-        EditorApp::new(params, store),
+        EditorApp::new(params, store).with_host_link(link),
     )
 }
 
@@ -173,6 +175,10 @@ pub struct EditorApp {
     params: Arc<RessortParams>,
     store: Arc<ModelStore>,
     gui: Option<GuiContext>,
+    /// Where the editor leaves its context so the plugin can show guard trips to the host.
+    link: Option<Arc<HostLink>>,
+    /// The guard's trip count the `guard` parameter was last raised for.
+    reported_trips: u32,
     reader: Option<MotionReader>,
     plot: PlotState,
     tab: Tab,
@@ -210,6 +216,8 @@ impl EditorApp {
             synced: running,
             store,
             gui: None,
+            link: None,
+            reported_trips: 0,
             reader: None,
             plot: PlotState::default(),
             tab,
@@ -219,6 +227,24 @@ impl EditorApp {
             last_frame: None,
             frame_times: [0.0; 32],
             frame_count: 0,
+        }
+    }
+
+    /// Hands the editor's context to `link` when the editor is built.
+    pub fn with_host_link(mut self, link: Arc<HostLink>) -> EditorApp {
+        self.link = Some(link);
+        self
+    }
+
+    /// Raises the `guard` parameter for trips the audio thread has not had reported (the
+    /// editor's own frames cover formats without a main-thread report).
+    fn report_trips(&mut self) {
+        let trips = self.store.runtime.guard_trips.load(Ordering::Acquire);
+        if trips != self.reported_trips {
+            self.reported_trips = trips;
+            if let Some(gui) = &self.gui {
+                set_guard_with(gui, &self.params, true);
+            }
         }
     }
 
@@ -312,6 +338,9 @@ impl EditorApp {
                 .clicked()
             {
                 rt.reset_requested.store(true, Ordering::Release);
+                if let Some(gui) = &self.gui {
+                    set_guard_with(gui, &self.params, false);
+                }
             }
             ui.separator();
             ui.label(
@@ -740,6 +769,11 @@ impl NiceEguiApp for EditorApp {
         // text renders (this crate enables the feature).
         egui_ctx.set_fonts(egui::FontDefinitions::default());
         egui_ctx.set_visuals(egui::Visuals::dark());
+        if let Some(link) = &self.link {
+            link.attach(nice_gui_ctx.clone());
+        }
+        // Trips from before the editor opened are for the host's report, not this one.
+        self.reported_trips = self.store.runtime.guard_trips.load(Ordering::Acquire);
         self.gui = Some(nice_gui_ctx);
         self.last_frame = None;
         Ok(())
@@ -760,6 +794,7 @@ impl NiceEguiApp for EditorApp {
         }
         self.store.collect_garbage();
         self.sync_script();
+        self.report_trips();
         let status = self.store.status();
 
         egui::Panel::top("top").show(ui, |ui| {

@@ -23,10 +23,12 @@ pub mod motion;
 pub mod params;
 pub mod plot;
 pub mod presets;
+pub mod report;
 pub mod runtime;
 
 use dsp::{db_to_gain, soft_ceiling, tuning_gain, ChunkSmoother, DcBlocker};
 use params::RessortParams;
+use report::{HostLink, MainThreadTask};
 use ressort_engine::RouteSource;
 use runtime::RuntimeStatus;
 
@@ -54,6 +56,10 @@ pub struct Ressort {
     params: Arc<RessortParams>,
     store: Arc<ModelStore>,
     editor_state: Arc<nice_plug_egui::EguiEditorState>,
+    /// The editor's context, to show guard trips to the host.
+    host_link: Arc<HostLink>,
+    /// A guard trip waits to be reported to the host at the end of the block.
+    report_trip: bool,
     /// Samples until the next Audition strike.
     audition_left: u64,
     sample_rate: f64,
@@ -131,6 +137,8 @@ impl Default for Ressort {
             params,
             store,
             editor_state: editor::default_state(),
+            host_link: Arc::new(HostLink::default()),
+            report_trip: false,
             audition_left: 0,
             sample_rate: 48_000.0,
             has_main_input: false,
@@ -481,12 +489,16 @@ impl Ressort {
     /// The guard reset the model: count it, raise the flag, fade back in.
     fn guard_tripped(&mut self) {
         self.restart_model();
-        // Atomics only: nice-plug 0.4.2's shared background worker exits when it runs a task
-        // of an instance that is gone, and the next instance's destruction then aborts the
-        // host, so the audio thread never queues tasks.
+        // Atomics, and at most one main-thread task per episode (CLAP only; see `report`).
+        // Never `execute_background`: nice-plug 0.4.2's shared background worker exits when
+        // it runs a task of an instance that is gone, and the next instance's destruction
+        // then aborts the host.
         let rt = &self.store.runtime;
         rt.guard_trips.fetch_add(1, Ordering::AcqRel);
-        rt.guard_active.store(true, Ordering::Release);
+        // One report per episode: an exploding model trips in every chunk.
+        if !rt.guard_active.swap(true, Ordering::AcqRel) {
+            self.report_trip = true;
+        }
     }
 }
 
@@ -545,7 +557,7 @@ impl Plugin for Ressort {
     const SAMPLE_ACCURATE_AUTOMATION: bool = true;
 
     type SysExMessage = ();
-    type BackgroundTask = ();
+    type BackgroundTask = MainThreadTask;
     type Editor = nice_plug_egui::EguiEditor<editor::EditorApp>;
 
     fn params(&self) -> Arc<dyn Params> {
@@ -557,7 +569,18 @@ impl Plugin for Ressort {
             self.params.clone(),
             self.store.clone(),
             self.editor_state.clone(),
+            self.host_link.clone(),
         )
+    }
+
+    fn task_executor(&mut self) -> TaskExecutor<Self> {
+        let params = self.params.clone();
+        let link = self.host_link.clone();
+        Box::new(move |task| match task {
+            MainThreadTask::ReportGuardTrip => {
+                link.set_guard(&params, true);
+            }
+        })
     }
 
     fn activate(
@@ -629,8 +652,8 @@ impl Plugin for Ressort {
                 // The output gain ramp of a cut chunk continues from where it got to.
                 if self.chunk_len > 0 {
                     let g1 = self.output_gain.value;
-                    self.last_output_gain +=
-                        (g1 - self.last_output_gain) * self.chunk_done as f64 / self.chunk_len as f64;
+                    self.last_output_gain += (g1 - self.last_output_gain) * self.chunk_done as f64
+                        / self.chunk_len as f64;
                 }
                 // To the next grid point: chunks realign to multiples of CHUNK.
                 self.chunk_len = CHUNK - (self.counter % CHUNK as u64) as usize;
@@ -777,6 +800,12 @@ impl Plugin for Ressort {
             if self.chunk_done >= self.chunk_len {
                 self.last_output_gain = g1;
             }
+        }
+        if std::mem::take(&mut self.report_trip)
+            && context.plugin_api() == PluginApi::Clap
+            && self.host_link.is_attached()
+        {
+            context.execute_gui(MainThreadTask::ReportGuardTrip);
         }
         let rt = &self.store.runtime;
         let seconds = frames as f64 / self.sample_rate;

@@ -32,6 +32,10 @@ pub struct RessortParams {
     /// The 40 Hz high-pass of the mi-gen example patches.
     #[id = "dc_filter"]
     pub dc_filter: BoolParam,
+    /// On when the explosion guard has reset the model; off again with the editor's Reset
+    /// model or by the user. Set by the plugin (see `report`), not automatable.
+    #[id = "guard"]
+    pub guard: BoolParam,
 
     /// Generic slots bound to the model's `param`s in declaration order.
     #[nested(array, group = "Macros")]
@@ -123,6 +127,11 @@ impl RessortParams {
             force_gain: gain_param("Force Gain", 0.0, -60.0, 40.0),
             position_gain: gain_param("Position Gain", 0.0, -60.0, 40.0),
             dc_filter: BoolParam::new("DC Filter", true),
+            guard: BoolParam::new("Guard Tripped", false)
+                .non_automatable()
+                .with_value_to_string(Arc::new(|on| {
+                    if on { "Tripped" } else { "Clear" }.to_string()
+                })),
             macros,
         }
     }

@@ -575,6 +575,17 @@ impl Score {
     }
 }
 
+/// Appends the parameter values among `events` to `into`.
+fn collect_param_values(events: &EventBuffer, into: &mut Vec<(ClapId, f64)>) {
+    for event in events.iter() {
+        if let Some(v) = event.as_event::<ParamValueEvent>() {
+            if let Some(id) = v.param_id() {
+                into.push((id, v.value()));
+            }
+        }
+    }
+}
+
 /// The result of [`TestPlugin::render`].
 #[derive(Clone, Debug, Default)]
 pub struct Rendered {
@@ -654,6 +665,9 @@ pub struct TestPlugin {
     processor: Option<StartedPluginAudioProcessor<TestHost>>,
     io: Option<Io>,
     ext: Extensions,
+    /// Parameter values the plugin sent to the host (`CLAP_EVENT_PARAM_VALUE` in the output
+    /// events of `process()` and `flush()`), in order.
+    param_output: Vec<(ClapId, f64)>,
     instance: PluginInstance<TestHost>,
 }
 
@@ -717,6 +731,7 @@ impl TestPlugin {
             processor: None,
             io: None,
             ext,
+            param_output: Vec::new(),
             instance,
         };
         plugin.idle();
@@ -1109,6 +1124,7 @@ impl TestPlugin {
             )
         });
         io.steady_time += n as u64;
+        collect_param_values(&io.out_events, &mut self.param_output);
         match result {
             Ok(status) => status,
             Err(e) => panic!("process() failed: {e}"),
@@ -1256,7 +1272,13 @@ impl TestPlugin {
                 .expect("inactive plugin");
             ext.flush(&mut handle, &in_events, &mut out_events);
         }
+        collect_param_values(&output, &mut self.param_output);
         self.idle();
+    }
+
+    /// The parameter values the plugin has sent to the host since the last call.
+    pub fn take_param_output(&mut self) -> Vec<(ClapId, f64)> {
+        std::mem::take(&mut self.param_output)
     }
 
     // --- state -----------------------------------------------------------------------------

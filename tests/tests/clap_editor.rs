@@ -1,18 +1,26 @@
 //! The editor in a CLAP host: the bundled plugin (built with `assert_process_allocs`) embeds
 //! its editor in a host window under a private Xvfb, through the CLAP gui extension as a DAW
 //! on Linux does. Sidechain strikes rendered by the host show up in the motion view; the host
-//! can resize the editor; closing it and destroying the instance is clean.
+//! can resize the editor; after the editor has been open, the host sees guard trips as the
+//! `Guard Tripped` parameter; closing it and destroying the instance is clean.
 //!
 //! The test runs in a child process that gets the Xvfb display in `DISPLAY`, so the X server
 //! outlives every X11 connection the plugin opened (Xlib exits the process when its server
 //! goes away).
 
 use ressort_tests::screen::{capture, plot_stats, shows_motion, HostWindow, Xvfb};
-use ressort_tests::{Score, TestPlugin};
+use ressort_tests::{state, Score, TestPlugin};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 const DISPLAY_ENV: &str = "RESSORT_TEST_DISPLAY";
+
+/// An oscillator far beyond the stability limit, displaced at rest: its guard trips at once.
+const EXPLODING: &str = "\
+# An oscillator far beyond the stability limit, displaced at rest (guard report test).
+@o osc 1. 1000. 0. 1. 0.
+@out1 posOutput @o
+";
 
 #[test]
 fn the_editor_opens_in_a_clap_host_and_shows_sidechain_strikes() {
@@ -101,6 +109,35 @@ fn the_editor_opens_in_a_clap_host_and_shows_sidechain_strikes() {
     }
 
     plugin.close_editor();
+
+    // The host sees a guard trip: the plugin raises `Guard Tripped` through the context the
+    // editor left (from the host's main-thread callback; the editor is closed by now).
+    let guard = plugin.param("Guard Tripped");
+    assert_eq!(plugin.param_value(guard.id), Some(0.0), "no trip yet");
+    plugin.deactivate();
+    let blob = state::with_model(&plugin.save_state(), "exploding", EXPLODING);
+    plugin.load_state(&blob).expect("load the exploding model");
+    plugin.take_param_output();
+    plugin.activate(48_000.0, 1, 512);
+    let out = plugin.render(0.1, 480, &Score::new());
+    assert!(out.audio.is_finite());
+    // The report reaches the host with the next block's output events.
+    plugin.render(0.01, 480, &Score::new());
+    let sent: Vec<f64> = plugin
+        .take_param_output()
+        .into_iter()
+        .filter(|(id, _)| *id == guard.id)
+        .map(|(_, v)| v)
+        .collect();
+    let value = plugin.param_value(guard.id);
+    println!(
+        "after the guard tripped: the plugin sent Guard Tripped = {sent:?}; the host reads {value:?} ({})",
+        plugin
+            .param_text(guard.id, value.unwrap_or(0.0))
+            .unwrap_or_default()
+    );
+    assert_eq!(sent, vec![1.0], "one parameter event reports the trip");
+    assert_eq!(value, Some(1.0));
     plugin.deactivate();
     drop(plugin);
     drop(host);

@@ -8,8 +8,8 @@
 
 use ressort_tests::state;
 use ressort_tests::{
-    band_energy_share, cents, oscillator_frequency, peak_frequency, run_isolated, Block, ClapId, ProcessStatus, Score,
-    Stereo, TestPlugin,
+    band_energy_share, cents, oscillator_frequency, peak_frequency, run_isolated, Block, ClapId,
+    ProcessStatus, Score, Stereo, TestPlugin,
 };
 use serde_json::json;
 
@@ -219,6 +219,7 @@ fn plugin_describes_its_ports_and_parameters() {
         "Force Gain",
         "Position Gain",
         "DC Filter",
+        "Guard Tripped",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -234,6 +235,15 @@ fn plugin_describes_its_ports_and_parameters() {
     ids.sort_unstable();
     ids.dedup();
     assert_eq!(ids.len(), params.len(), "duplicate parameter ids");
+    // The guard flag is the plugin's to set: visible, not automatable.
+    const CLAP_PARAM_IS_AUTOMATABLE: u32 = 1 << 5;
+    const CLAP_PARAM_IS_HIDDEN: u32 = 1 << 2;
+    let guard = plugin.param("Guard Tripped");
+    assert_eq!(
+        guard.flags & (CLAP_PARAM_IS_AUTOMATABLE | CLAP_PARAM_IS_HIDDEN),
+        0
+    );
+    assert_eq!(plugin.param_text(guard.id, 0.0).as_deref(), Some("Clear"));
 
     // The documented plain ranges, through the plugin's own value texts.
     let p = Params::of(&mut plugin);
@@ -677,7 +687,10 @@ fn a_stiffness_sweep_has_no_zipper_noise() {
         assert_finite_and_sounding(&out.audio, "low-oscillator-force");
         let segment = &out.audio.left[(start * sr) as usize..((start + seconds) * sr) as usize];
         let peak = segment.iter().fold(0.0f32, |m, x| m.max(x.abs()));
-        assert!(peak < 0.5, "the soft ceiling would add harmonics (peak {peak})");
+        assert!(
+            peak < 0.5,
+            "the soft ceiling would add harmonics (peak {peak})"
+        );
         band_energy_share(segment, sr, 2_000.0, 20_000.0)
     };
     let db = |share: f64| 10.0 * share.max(1e-30).log10();
