@@ -30,6 +30,11 @@ use std::time::Instant;
 pub const DEFAULT_SIZE: (f32, f32) = (1100.0, 700.0);
 /// The smallest size the window can be resized to.
 pub const MIN_SIZE: (f32, f32) = (780.0, 500.0);
+/// Widths of the model panel (left) and the controls (right): minimum, default, maximum.
+const LEFT_PANEL: (f32, f32, f32) = (240.0, 380.0, 700.0);
+const RIGHT_PANEL: (f32, f32, f32) = (240.0, 300.0, 480.0);
+/// The width the side panels leave to the motion view when the window allows it.
+const MIN_VIEW_WIDTH: f32 = 300.0;
 /// Largest file the model panel loads.
 const MAX_SCRIPT_BYTES: u64 = 16 << 20;
 
@@ -720,7 +725,7 @@ impl EditorApp {
             return;
         };
         let view = reader.view.clone();
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             let current = match self.plot.buffer {
                 Some(b) if b < view.named().len() => format!("buffer {}", view.named()[b].name),
                 _ => format!("all points ({})", view.len()),
@@ -802,9 +807,13 @@ impl NiceEguiApp for EditorApp {
             self.top_bar(ui, &status);
             ui.add_space(2.0);
         });
+        // The side panels give way so that the motion view keeps room in a narrow window.
+        let width = ui.available_width();
+        let left_max = (width - RIGHT_PANEL.1 - MIN_VIEW_WIDTH).clamp(LEFT_PANEL.0, LEFT_PANEL.2);
+        let right_max = (width - LEFT_PANEL.0 - MIN_VIEW_WIDTH).clamp(RIGHT_PANEL.0, RIGHT_PANEL.2);
         egui::Panel::left("model")
-            .default_size(380.0)
-            .size_range(280.0..=700.0)
+            .default_size(LEFT_PANEL.1.min(left_max))
+            .size_range(LEFT_PANEL.0..=left_max)
             .show(ui, |ui| {
                 ui.horizontal(|ui| {
                     ui.selectable_value(&mut self.tab, Tab::Presets, "Presets");
@@ -822,8 +831,8 @@ impl NiceEguiApp for EditorApp {
                 }
             });
         egui::Panel::right("controls")
-            .default_size(300.0)
-            .size_range(240.0..=480.0)
+            .default_size(RIGHT_PANEL.1.min(right_max))
+            .size_range(RIGHT_PANEL.0..=right_max)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical()
                     .id_salt("controls")

@@ -575,6 +575,13 @@ impl Score {
     }
 }
 
+/// The number of threads in this process (Linux: `/proc/self/task`).
+pub fn thread_count() -> usize {
+    std::fs::read_dir("/proc/self/task")
+        .map(|d| d.count())
+        .unwrap_or(0)
+}
+
 /// Appends the parameter values among `events` to `into`.
 fn collect_param_values(events: &EventBuffer, into: &mut Vec<(ClapId, f64)>) {
     for event in events.iter() {
@@ -782,6 +789,29 @@ impl TestPlugin {
             let handle = self.instance.plugin_handle();
             let _ = gui.hide(&handle);
             gui.destroy(&handle);
+        }
+    }
+
+    /// [`TestPlugin::close_editor`], then waits (up to `timeout`) until the process has no
+    /// more threads than `threads_before`: baseview tears its window thread down after
+    /// `destroy` returns, and a process that exits meanwhile crashes in Mesa's EGL teardown
+    /// (`eglTerminate` unloading the DRI driver during `exit`). Returns whether it got there.
+    pub fn close_editor_and_wait(
+        &mut self,
+        threads_before: usize,
+        timeout: std::time::Duration,
+    ) -> bool {
+        self.close_editor();
+        let deadline = std::time::Instant::now() + timeout;
+        loop {
+            if thread_count() <= threads_before {
+                return true;
+            }
+            if std::time::Instant::now() > deadline {
+                return false;
+            }
+            self.idle();
+            std::thread::sleep(std::time::Duration::from_millis(20));
         }
     }
 

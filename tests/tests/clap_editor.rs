@@ -9,7 +9,7 @@
 //! goes away).
 
 use ressort_tests::screen::{capture, plot_stats, shows_motion, HostWindow, Xvfb};
-use ressort_tests::{state, Score, TestPlugin};
+use ressort_tests::{state, thread_count, Score, TestPlugin};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -40,6 +40,7 @@ fn the_editor_opens_in_a_clap_host_and_shows_sidechain_strikes() {
     let host = HostWindow::open(&display, "Test DAW", 1100, 700).expect("host window");
 
     let mut plugin = TestPlugin::new();
+    let threads_before = thread_count();
     let (w, h) = plugin.open_editor(host.window).expect("the editor opens");
     println!("editor size {w}×{h}");
     assert_eq!((w, h), (1100, 700), "the editor's default size");
@@ -108,7 +109,12 @@ fn the_editor_opens_in_a_clap_host_and_shows_sidechain_strikes() {
         std::thread::sleep(Duration::from_millis(100));
     }
 
-    plugin.close_editor();
+    // The editor's window thread finishes before the process can exit.
+    assert!(
+        plugin.close_editor_and_wait(threads_before, Duration::from_secs(10)),
+        "the editor's threads did not finish within 10 s of closing it ({} > {threads_before})",
+        thread_count()
+    );
 
     // The host sees a guard trip: the plugin raises `Guard Tripped` through the context the
     // editor left (from the host's main-thread callback; the editor is closed by now).
