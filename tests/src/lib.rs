@@ -1503,21 +1503,8 @@ fn describe_exit(status: &std::process::ExitStatus) -> String {
 /// around the peak bin. For a steady sinusoid over N samples the error is a small fraction
 /// of a bin (SR/N).
 pub fn peak_frequency(signal: &[f32], sample_rate: f64, lo_hz: f64, hi_hz: f64) -> f64 {
-    use realfft::RealFftPlanner;
     let n = signal.len();
-    assert!(n >= 16, "too short for a spectrum: {n} samples");
-    let mean = signal.iter().map(|&v| v as f64).sum::<f64>() / n as f64;
-    let mut buf: Vec<f64> = signal
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| {
-            let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos();
-            (v as f64 - mean) * w
-        })
-        .collect();
-    let fft = RealFftPlanner::<f64>::new().plan_fft_forward(n);
-    let mut spectrum = fft.make_output_vec();
-    fft.process(&mut buf, &mut spectrum).expect("FFT");
+    let spectrum = hann_spectrum(signal);
     let bin_hz = sample_rate / n as f64;
     let lo = ((lo_hz / bin_hz).floor() as usize).max(1);
     let hi = ((hi_hz / bin_hz).ceil() as usize).min(spectrum.len() - 2);
@@ -1536,9 +1523,8 @@ pub fn peak_frequency(signal: &[f32], sample_rate: f64, lo_hz: f64, hi_hz: f64) 
     (k as f64 + delta) * bin_hz
 }
 
-/// The share of a signal's energy between `lo_hz` and `hi_hz` (mean removed, Hann window):
-/// 1 when all of it lies in the band.
-pub fn band_energy_share(signal: &[f32], sample_rate: f64, lo_hz: f64, hi_hz: f64) -> f64 {
+/// The spectrum of a signal with its mean removed, under a Hann window (realfft).
+fn hann_spectrum(signal: &[f32]) -> Vec<realfft::num_complex::Complex<f64>> {
     use realfft::RealFftPlanner;
     let n = signal.len();
     assert!(n >= 16, "too short for a spectrum: {n} samples");
@@ -1554,6 +1540,14 @@ pub fn band_energy_share(signal: &[f32], sample_rate: f64, lo_hz: f64, hi_hz: f6
     let fft = RealFftPlanner::<f64>::new().plan_fft_forward(n);
     let mut spectrum = fft.make_output_vec();
     fft.process(&mut buf, &mut spectrum).expect("FFT");
+    spectrum
+}
+
+/// The share of a signal's energy between `lo_hz` and `hi_hz` (mean removed, Hann window):
+/// 1 when all of it lies in the band.
+pub fn band_energy_share(signal: &[f32], sample_rate: f64, lo_hz: f64, hi_hz: f64) -> f64 {
+    let n = signal.len();
+    let spectrum = hann_spectrum(signal);
     let bin_hz = sample_rate / n as f64;
     let power: Vec<f64> = spectrum.iter().map(|c| c.norm_sqr()).collect();
     let total: f64 = power.iter().sum();
