@@ -577,9 +577,7 @@ impl Plugin for Ressort {
         let params = self.params.clone();
         let link = self.host_link.clone();
         Box::new(move |task| match task {
-            MainThreadTask::ReportGuardTrip => {
-                link.set_guard(&params, true);
-            }
+            MainThreadTask::ReportGuardTrip => link.set_guard(&params, true),
         })
     }
 
@@ -649,9 +647,12 @@ impl Plugin for Ressort {
         while pos < frames {
             if self.chunk_done >= self.chunk_len || automated {
                 automated = false;
-                // The output gain ramp of a cut chunk continues from where it got to.
-                if self.chunk_len > 0 {
-                    let g1 = self.output_gain.value;
+                // The next ramp starts where this one got to: its end, or where automation
+                // cut it.
+                let g1 = self.output_gain.value;
+                if self.chunk_done >= self.chunk_len {
+                    self.last_output_gain = g1;
+                } else {
                     self.last_output_gain += (g1 - self.last_output_gain) * self.chunk_done as f64
                         / self.chunk_len as f64;
                 }
@@ -797,9 +798,6 @@ impl Plugin for Ressort {
             pos += len;
             self.counter += len as u64;
             self.chunk_done += len;
-            if self.chunk_done >= self.chunk_len {
-                self.last_output_gain = g1;
-            }
         }
         if std::mem::take(&mut self.report_trip)
             && context.plugin_api() == PluginApi::Clap

@@ -42,15 +42,13 @@ impl HostLink {
         self.attached.load(Ordering::Acquire)
     }
 
-    /// Sets the `guard` parameter as the host sees it. Returns false when no editor has been
-    /// built yet (no context to send it through).
-    pub fn set_guard(&self, params: &RessortParams, tripped: bool) -> bool {
+    /// Sets the `guard` parameter as the host sees it; nothing when no editor has been built
+    /// yet (no context to send it through).
+    pub fn set_guard(&self, params: &RessortParams, tripped: bool) {
         let context = self.context.lock().unwrap_or_else(|e| e.into_inner());
-        let Some(context) = context.as_ref() else {
-            return false;
-        };
-        set_guard_with(context, params, tripped);
-        true
+        if let Some(context) = context.as_ref() {
+            set_guard_with(context, params, tripped);
+        }
     }
 }
 
