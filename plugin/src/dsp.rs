@@ -22,11 +22,33 @@ impl DcBlocker {
     #[inline]
     pub fn process(&mut self, x: f64) -> f64 {
         self.state += self.coefficient * (x - self.state);
+        // After a DC offset goes away the state decays geometrically and would reach the
+        // subnormal range (seconds later), where every operation on it is slow. Far below
+        // anything audible it is zero.
+        if self.state.abs() < FLUSH_LEVEL {
+            self.state = 0.0;
+        }
         x - self.state
     }
 
     pub fn reset(&mut self) {
         self.state = 0.0;
+    }
+}
+
+/// Levels below this are flushed to zero in the output stage's state: 10⁻³⁰ is 600 dB below
+/// full scale, and far above the subnormal range of f32 (10⁻³⁸) and f64.
+pub const FLUSH_LEVEL: f64 = 1e-30;
+
+/// An output sample as the host receives it: f32, with anything below [`FLUSH_LEVEL`] (which
+/// would be subnormal or close to it in f32) written as exactly 0. Hosts and validators
+/// reject subnormal output, and the next plugin in the chain would pay for it.
+#[inline]
+pub fn output_sample(x: f64) -> f32 {
+    if x.abs() < FLUSH_LEVEL {
+        0.0
+    } else {
+        x as f32
     }
 }
 
@@ -138,6 +160,40 @@ mod tests {
         assert_eq!(soft_ceiling(f64::NAN), 0.0);
         assert_eq!(soft_ceiling(f64::INFINITY), 0.0);
         assert!(soft_ceiling(1e300) <= 1.0);
+    }
+
+    #[test]
+    fn output_is_never_subnormal() {
+        for x in [1e-40, -1.27e-40, 1e-35, -1e-31, 1e-300, f64::MIN_POSITIVE / 2.0, 0.0, -0.0] {
+            let y = output_sample(x);
+            assert!(!y.is_subnormal(), "{x} -> {y:e}");
+            assert_eq!(y, 0.0, "{x}");
+        }
+        assert_eq!(output_sample(0.25), 0.25);
+        assert_eq!(output_sample(-1e-20), -1e-20f32);
+        // The smallest normal f32 itself passes; nothing between it and zero is written.
+        for i in 0..2000 {
+            let x = 1e-45 * 1.05f64.powi(i);
+            let y = output_sample(x);
+            assert!(!y.is_subnormal(), "{x:e} -> {y:e}");
+        }
+    }
+
+    #[test]
+    fn dc_blocker_tail_reaches_zero_not_subnormals() {
+        // A DC step that goes away: the filter's state decays to exactly 0 instead of
+        // through the subnormal range.
+        let mut dc = DcBlocker::new(48_000.0);
+        for _ in 0..48_000 {
+            dc.process(1.0);
+        }
+        let mut last = 1.0;
+        for _ in 0..48_000 * 10 {
+            last = dc.process(0.0);
+            assert!(!last.is_subnormal() && !dc.state.is_subnormal());
+        }
+        assert_eq!(last, 0.0);
+        assert_eq!(dc.state, 0.0);
     }
 
     #[test]

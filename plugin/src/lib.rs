@@ -17,16 +17,19 @@ use std::sync::Arc;
 
 pub mod dsp;
 pub mod editor;
+pub mod envelope;
 pub mod host;
+pub mod macros;
 pub mod model;
 pub mod motion;
+pub mod param_text;
 pub mod params;
 pub mod plot;
 pub mod presets;
 pub mod report;
 pub mod runtime;
 
-use dsp::{db_to_gain, soft_ceiling, tuning_gain, ChunkSmoother, DcBlocker};
+use dsp::{db_to_gain, output_sample, soft_ceiling, tuning_gain, ChunkSmoother, DcBlocker};
 use params::RessortParams;
 use report::{HostLink, MainThreadTask};
 use ressort_engine::RouteSource;
@@ -777,10 +780,10 @@ impl Plugin for Ressort {
                 let (l, r) = (soft_ceiling(l), soft_ceiling(r));
                 loudest = loudest.max(l.abs()).max(r.abs());
                 if let Some(ch) = out.get_mut(0) {
-                    ch[pos + i] = l as f32;
+                    ch[pos + i] = output_sample(l);
                 }
                 if let Some(ch) = out.get_mut(1) {
-                    ch[pos + i] = r as f32;
+                    ch[pos + i] = output_sample(r);
                 }
                 if tripped {
                     // Silence the rest of this chunk; the guard fade starts at the next one.

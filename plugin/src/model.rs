@@ -8,14 +8,19 @@
 //! so it never allocates or frees. A script with errors never replaces the running model; its
 //! diagnostics are kept in [`ModelStore::status`] for the editor.
 
+use crate::envelope::{envelope, raw_envelope, worst_load};
 use crate::host::HostSettings;
+pub use crate::envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
+use crate::macros::macro_bindings;
+pub use crate::macros::MacroBinding;
+use crate::param_text;
 use crate::motion::{motion_channel, MotionReader, MotionWriter};
 use crate::runtime::RuntimeStatus;
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::params::persist::PersistentField;
 use ressort_engine::{
-    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, ParamId, RouteSource,
-    SampleRateMode, ScaleClass, REFERENCE_SAMPLE_RATE_HZ,
+    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, RouteSource,
+    SampleRateMode, REFERENCE_SAMPLE_RATE_HZ,
 };
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -28,10 +33,6 @@ pub const CHUNK: usize = 16;
 
 /// The number of generic macro slots.
 pub const NUM_MACROS: usize = 16;
-
-/// Stability budget kept free by the Stiffness/Damping clamp: the loads of every mass and
-/// uniform structure stay below this fraction of the limit.
-pub const STABILITY_HEADROOM: f64 = 0.95;
 
 /// The saved part of the model: the script of the running model and where it came from.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -53,151 +54,6 @@ pub enum InputRole {
     AudioParam,
     /// Declared by no element.
     Unused,
-}
-
-/// A macro slot bound to one of the model's `param`s.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MacroBinding {
-    pub param: ParamId,
-    pub name: String,
-    /// The declared value: the slot's centre (normalized 0.5).
-    pub default: f64,
-    pub min: f64,
-    pub max: f64,
-}
-
-impl MacroBinding {
-    /// Maps a slot position in [0, 1] to the parameter value: min at 0, the declared value
-    /// at 0.5, max at 1; geometric between positive bounds, linear otherwise.
-    pub fn value_at(&self, normalized: f64) -> f64 {
-        let n = normalized.clamp(0.0, 1.0);
-        let (a, b, t) = if n <= 0.5 {
-            (self.min, self.default, n * 2.0)
-        } else {
-            (self.default, self.max, (n - 0.5) * 2.0)
-        };
-        if a > 0.0 && b > 0.0 {
-            a * (b / a).powf(t)
-        } else {
-            a + (b - a) * t
-        }
-    }
-}
-
-/// One line of the stability envelope: a mass or structure whose load is
-/// `k·gK + z·gZ` for Stiffness gain gK and Damping gain gZ (stable below 1).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LoadLine {
-    pub k: f64,
-    pub z: f64,
-}
-
-/// The loads that can limit the host gains, reduced to the ones that can be the worst for
-/// some gain pair (a mass whose K and Z loads are both below another's never limits).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct StabilityEnvelope {
-    pub lines: Vec<LoadLine>,
-    /// The factor applied to the analysed loads (below 1 when the bound rejected the model
-    /// as written; see [`envelope`]).
-    pub scale: f64,
-}
-
-impl StabilityEnvelope {
-    /// The largest Stiffness gain that keeps every load below [`STABILITY_HEADROOM`] at
-    /// Damping gain `gz` (infinite when no load depends on K).
-    pub fn max_stiffness(&self, gz: f64) -> f64 {
-        let mut g = f64::INFINITY;
-        for l in &self.lines {
-            if l.k > 0.0 {
-                g = g.min(((STABILITY_HEADROOM - gz * l.z) / l.k).max(0.0));
-            }
-        }
-        g
-    }
-
-    /// The largest Damping gain that keeps every load below the headroom at Stiffness gain
-    /// `gk`.
-    pub fn max_damping(&self, gk: f64) -> f64 {
-        let mut g = f64::INFINITY;
-        for l in &self.lines {
-            if l.z > 0.0 {
-                g = g.min(((STABILITY_HEADROOM - gk * l.k) / l.z).max(0.0));
-            }
-        }
-        g
-    }
-
-    /// Clamps a requested (Stiffness, Damping) gain pair into the stable region. Damping may
-    /// use only the budget left by `min(gk, k_floor)` (so turning Damping up never takes the
-    /// model's own stiffness away), then Stiffness takes what remains. Returns the gains and
-    /// whether anything was clamped.
-    pub fn clamp(&self, gk: f64, gz: f64, k_floor: f64) -> (f64, f64, bool) {
-        self.clamp_moved(gk, gz, k_floor, &[])
-    }
-
-    fn from_loads(mut loads: Vec<LoadLine>) -> StabilityEnvelope {
-        // Sort by K load, largest first; keep a line only if its Z load beats every line with a
-        // larger K load.
-        loads.sort_by(|a, b| b.k.total_cmp(&a.k).then(b.z.total_cmp(&a.z)));
-        let mut lines: Vec<LoadLine> = Vec::new();
-        let mut best_z = f64::NEG_INFINITY;
-        for l in loads {
-            if !(l.k.is_finite() && l.z.is_finite()) {
-                continue;
-            }
-            if l.z > best_z {
-                best_z = l.z;
-                lines.push(l);
-            }
-        }
-        StabilityEnvelope { lines, scale: 1.0 }
-    }
-
-    fn scaled(mut self, scale: f64) -> StabilityEnvelope {
-        for l in &mut self.lines {
-            l.k *= scale;
-            l.z *= scale;
-        }
-        self.scale = scale;
-        self
-    }
-
-    /// Clamps like [`StabilityEnvelope::clamp`] while macro slots move parameters: `moved`
-    /// holds, per moved slot, the envelope at the end of its range it moved towards and how
-    /// far (0 … 1, linear in the parameter value). Each limit is interpolated harmonically
-    /// between this envelope's and the moved one's, which bounds the true limit from below
-    /// when loads depend linearly on the parameter; the tightest slot wins.
-    pub fn clamp_moved(
-        &self,
-        gk: f64,
-        gz: f64,
-        k_floor: f64,
-        moved: &[(&StabilityEnvelope, f64)],
-    ) -> (f64, f64, bool) {
-        const TOLERANCE: f64 = 1.0 + 1e-9;
-        let blend = |a: f64, b: f64, f: f64| -> f64 {
-            if !(a.is_finite() && b.is_finite()) {
-                return a.min(b);
-            }
-            let inv = (1.0 - f) / a.max(1e-300) + f / b.max(1e-300);
-            1.0 / inv
-        };
-        let z_limit = moved
-            .iter()
-            .fold(self.max_damping(gk.min(k_floor)), |acc, (e, f)| {
-                acc.min(blend(
-                    self.max_damping(gk.min(k_floor)),
-                    e.max_damping(gk.min(k_floor)),
-                    *f,
-                ))
-            });
-        let z = gz.min(z_limit * TOLERANCE);
-        let k_limit = moved.iter().fold(self.max_stiffness(z), |acc, (e, f)| {
-            acc.min(blend(self.max_stiffness(z), e.max_stiffness(z), *f))
-        });
-        let k = gk.min(k_limit * TOLERANCE);
-        (k, z, k < gk || z < gz)
-    }
 }
 
 /// A model ready to run: compiled for one sample rate, with its scratch buffers.
@@ -485,140 +341,6 @@ pub fn peak_frequency(signal: &[f64], sample_rate: f64) -> Option<f64> {
     Some((best as f64 + delta.clamp(-0.5, 0.5)) * sample_rate / n as f64)
 }
 
-/// The highest coupled load of the model and the mass that has it.
-fn worst_load(report: &ressort_engine::StabilityReport) -> (f64, String) {
-    report
-        .masses
-        .iter()
-        .max_by(|a, b| a.coupled_load().total_cmp(&b.coupled_load()))
-        .map(|m| (m.coupled_load(), m.label.clone()))
-        .unwrap_or((0.0, String::new()))
-}
-
-/// Splits the coupled (Gershgorin) load of every mass, (K_eq + K_coupled + 2(Z_eq +
-/// Z_coupled))/4M, into its Stiffness and Damping parts by analysing the model with one class
-/// switched off at a time (a nonlinear law can put K-class arguments into its damping bound).
-/// Below 1 for every mass, no mode of the linearised network exceeds the time step's limit;
-/// the per-mass rule of spec §5.2 alone lets coupled chains explode at half the stiffness it
-/// allows.
-///
-/// The Gershgorin bound can be pessimistic (a small triangular lattice passes at unit gains
-/// although its bound says 1.5), and the model as written is the author's decision: when the
-/// bound rejects unit gains, the whole envelope is scaled so that unit gains sit exactly at
-/// the headroom. The clamp then never takes away what the script asks for.
-fn envelope(engine: &mut Engine) -> StabilityEnvelope {
-    let raw = raw_envelope(engine);
-    let unit = raw.lines.iter().map(|l| l.k + l.z).fold(0.0, f64::max);
-    let scale = if unit > STABILITY_HEADROOM {
-        STABILITY_HEADROOM / unit
-    } else {
-        1.0
-    };
-    raw.scaled(scale)
-}
-
-/// The envelope of the model's current parameter values, unscaled.
-fn raw_envelope(engine: &mut Engine) -> StabilityEnvelope {
-    let coupled = |r: &ressort_engine::StabilityReport| -> Vec<f64> {
-        r.masses.iter().map(|m| m.coupled_load()).collect()
-    };
-    engine.set_class_gain(ScaleClass::Damping, 0.0);
-    let k = coupled(&engine.stability());
-    engine.set_class_gain(ScaleClass::Damping, 1.0);
-    engine.set_class_gain(ScaleClass::Stiffness, 0.0);
-    let z = coupled(&engine.stability());
-    engine.set_class_gain(ScaleClass::Stiffness, 1.0);
-    engine.apply_pending_changes();
-    let loads = k
-        .into_iter()
-        .zip(z)
-        .map(|(k, z)| LoadLine { k, z })
-        .collect();
-    StabilityEnvelope::from_loads(loads)
-}
-
-/// Binds the macro slots to the model's control-rate `param`s in declaration order, with the
-/// script's ranges or a default range around the declared value that the stability analysis
-/// accepts.
-fn macro_bindings(engine: &mut Engine, settings: &HostSettings) -> Vec<Option<MacroBinding>> {
-    let params: Vec<(usize, String, f64)> = engine
-        .info()
-        .params
-        .iter()
-        .enumerate()
-        .filter(|(_, p)| p.audio_input.is_none())
-        .map(|(i, p)| (i, p.name.clone(), p.default))
-        .collect();
-    let mut out: Vec<Option<MacroBinding>> = vec![None; NUM_MACROS];
-    let base_stable = engine.stability().is_stable();
-    for (slot, (index, name, default)) in params.into_iter().take(NUM_MACROS).enumerate() {
-        let id = ParamId(index as u32);
-        let declared = settings.macro_ranges.iter().find(|r| r.name == name);
-        let (min, max) = match declared {
-            Some(r) => (r.min, r.max),
-            None => {
-                let (lo, hi) = default_range(default);
-                let hi = if base_stable {
-                    stable_towards(engine, id, default, hi)
-                } else {
-                    hi
-                };
-                let lo = if base_stable {
-                    stable_towards(engine, id, default, lo)
-                } else {
-                    lo
-                };
-                (lo, hi)
-            }
-        };
-        let _ = engine.set_param(id, default);
-        out[slot] = Some(MacroBinding {
-            param: id,
-            name,
-            default: default.clamp(min.min(max), max.max(min)),
-            min,
-            max,
-        });
-    }
-    engine.apply_pending_changes();
-    out
-}
-
-/// ×1/4 … ×4 around a non-zero value; 0 … 1 around zero.
-fn default_range(v: f64) -> (f64, f64) {
-    if v > 0.0 {
-        (v / 4.0, v * 4.0)
-    } else if v < 0.0 {
-        (v * 4.0, v / 4.0)
-    } else {
-        (0.0, 1.0)
-    }
-}
-
-/// The value closest to `target` on the segment from `from` (stable) that keeps the model
-/// stable, found by bisection.
-fn stable_towards(engine: &mut Engine, id: ParamId, from: f64, target: f64) -> f64 {
-    let stable_at = |engine: &mut Engine, v: f64| {
-        engine.set_param(id, v).is_ok() && {
-            let r = engine.stability();
-            worst_load(&r).0 < STABILITY_HEADROOM
-        }
-    };
-    if stable_at(engine, target) {
-        return target;
-    }
-    let (mut good, mut bad) = (from, target);
-    for _ in 0..24 {
-        let mid = 0.5 * (good + bad);
-        if stable_at(engine, mid) {
-            good = mid;
-        } else {
-            bad = mid;
-        }
-    }
-    good
-}
-
 impl Prepared {
     /// The editor's description of this model.
     pub fn summary(&mut self) -> ModelSummary {
@@ -752,7 +474,19 @@ impl ModelStore {
         let status = lock(&self.status);
         match status.summary.macros.get(slot) {
             Some(Some(b)) => format!("{} = {}", b.name, format_value(b.value_at(normalized))),
-            _ => format!("unbound ({:.0} %)", normalized * 100.0),
+            _ => param_text::format_unbound_macro(normalized),
+        }
+    }
+
+    /// The slot position for a macro's text (the inverse of [`ModelStore::macro_text`]):
+    /// `K = 0.12` or `0.12` for a slot bound to `K`, `50 %` for an unbound one.
+    pub fn macro_from_text(&self, slot: usize, text: &str) -> Option<f64> {
+        let status = lock(&self.status);
+        match status.summary.macros.get(slot) {
+            Some(Some(b)) => {
+                param_text::parse_bound_macro(text, &b.name).map(|v| b.normalized_of(v))
+            }
+            _ => param_text::parse_unbound_macro(text),
         }
     }
 

@@ -1,12 +1,20 @@
 //! The plugin's parameters. Their ids are part of every saved project: never rename one.
 
 use crate::model::{ModelStore, NUM_MACROS};
+use crate::param_text::{
+    format_db, format_factor, format_semitones, parse_db, parse_factor, parse_semitones,
+    parse_switch,
+};
 use nice_plug::prelude::*;
 use std::sync::Arc;
 
 /// Stiffness and Damping are stored in octaves (log₂ of the factor): the knob is logarithmic
 /// from ×1/16 to ×16 and automation lanes are linear in octaves.
 pub const GAIN_OCTAVES: f32 = 4.0;
+
+/// The texts of the Guard Tripped parameter.
+const GUARD_OFF: &str = "Clear";
+const GUARD_ON: &str = "Tripped";
 
 #[derive(Params)]
 pub struct RessortParams {
@@ -58,29 +66,9 @@ fn factor_param(name: &'static str) -> FloatParam {
             max: GAIN_OCTAVES,
         },
     )
+    .with_unit(" ×")
     .with_value_to_string(Arc::new(|octaves| format_factor(2f32.powf(octaves))))
-    .with_string_to_value(Arc::new(parse_factor))
-}
-
-/// `×1.00`, `×0.063`, `×16.0`.
-pub fn format_factor(f: f32) -> String {
-    if f >= 10.0 {
-        format!("×{f:.1}")
-    } else if f >= 1.0 {
-        format!("×{f:.2}")
-    } else {
-        format!("×{f:.3}")
-    }
-}
-
-/// Accepts `×2`, `x2`, `2`, `1/4`; returns octaves.
-pub fn parse_factor(text: &str) -> Option<f32> {
-    let t = text.trim().trim_start_matches(['×', 'x', 'X', '*']).trim();
-    let f: f32 = match t.split_once('/') {
-        Some((a, b)) => a.trim().parse::<f32>().ok()? / b.trim().parse::<f32>().ok()?,
-        None => t.parse().ok()?,
-    };
-    (f.is_finite() && f > 0.0).then(|| f.log2().clamp(-GAIN_OCTAVES, GAIN_OCTAVES))
+    .with_string_to_value(Arc::new(|text| parse_factor(text, GAIN_OCTAVES)))
 }
 
 fn gain_param(name: &'static str, default_db: f32, min_db: f32, max_db: f32) -> FloatParam {
@@ -94,19 +82,25 @@ fn gain_param(name: &'static str, default_db: f32, min_db: f32, max_db: f32) -> 
     )
     .with_unit(" dB")
     .with_step_size(0.1)
+    .with_value_to_string(Arc::new(format_db))
+    .with_string_to_value(Arc::new(parse_db))
 }
 
 impl RessortParams {
     pub fn new(model: Arc<ModelStore>) -> RessortParams {
         let macros = std::array::from_fn(|slot| {
             let store = model.clone();
+            let parse_store = model.clone();
             MacroParam {
                 value: FloatParam::new(
                     format!("Macro {}", slot + 1),
                     0.5,
                     FloatRange::Linear { min: 0.0, max: 1.0 },
                 )
-                .with_value_to_string(Arc::new(move |v| store.macro_text(slot, v as f64))),
+                .with_value_to_string(Arc::new(move |v| store.macro_text(slot, v as f64)))
+                .with_string_to_value(Arc::new(move |text| {
+                    parse_store.macro_from_text(slot, text).map(|n| n as f32)
+                })),
             }
         });
         RessortParams {
@@ -122,7 +116,9 @@ impl RessortParams {
                 },
             )
             .with_unit(" st")
-            .with_step_size(0.01),
+            .with_step_size(0.01)
+            .with_value_to_string(Arc::new(format_semitones))
+            .with_string_to_value(Arc::new(parse_semitones)),
             output_gain: gain_param("Output Gain", 24.0, -40.0, 60.0),
             force_gain: gain_param("Force Gain", 0.0, -60.0, 40.0),
             position_gain: gain_param("Position Gain", 0.0, -60.0, 40.0),
@@ -130,28 +126,10 @@ impl RessortParams {
             guard: BoolParam::new("Guard Tripped", false)
                 .non_automatable()
                 .with_value_to_string(Arc::new(|on| {
-                    if on { "Tripped" } else { "Clear" }.to_string()
-                })),
+                    if on { GUARD_ON } else { GUARD_OFF }.to_string()
+                }))
+                .with_string_to_value(Arc::new(|text| parse_switch(text, GUARD_OFF, GUARD_ON))),
             macros,
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn factors_round_trip_through_text() {
-        for octaves in [-4.0f32, -1.0, 0.0, 0.5, 4.0] {
-            let text = format_factor(2f32.powf(octaves));
-            let back = parse_factor(&text).unwrap();
-            assert!((back - octaves).abs() < 0.01, "{text}: {back}");
-        }
-        assert_eq!(parse_factor("1/4"), Some(-2.0));
-        assert_eq!(parse_factor("x2"), Some(1.0));
-        assert_eq!(parse_factor("1000"), Some(4.0));
-        assert_eq!(parse_factor("-1"), None);
-        assert_eq!(parse_factor("abc"), None);
     }
 }

@@ -1279,6 +1279,13 @@ impl TestPlugin {
             .map(|b| String::from_utf8_lossy(b).into_owned())
     }
 
+    /// The value the plugin reads from `text` (`clap_plugin_params.text_to_value`).
+    pub fn param_value_of_text(&mut self, id: ClapId, text: &str) -> Option<f64> {
+        let ext = self.params_ext();
+        let text = std::ffi::CString::new(text).ok()?;
+        ext.text_to_value(&self.instance.plugin_handle(), id, &text)
+    }
+
     /// Sets parameters outside `process()` through `clap_plugin_params.flush` (on the main
     /// thread when inactive, on the audio thread when active, as CLAP requires).
     pub fn flush_params(&mut self, values: &[(ClapId, f64)]) {
