@@ -7,11 +7,14 @@
 
 use std::fmt;
 
-/// How serious a diagnostic is. Errors block the model; warnings do not (spec §3.12 f).
+/// How serious a diagnostic is. Errors block the model; warnings and notes do not (spec
+/// §3.12 f). A note marks something accepted as written, such as a legacy form, with the
+/// modern way to write it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Severity {
     Error,
     Warning,
+    Note,
 }
 
 impl fmt::Display for Severity {
@@ -19,6 +22,7 @@ impl fmt::Display for Severity {
         f.write_str(match self {
             Severity::Error => "error",
             Severity::Warning => "warning",
+            Severity::Note => "note",
         })
     }
 }
@@ -173,7 +177,7 @@ impl DiagnosticCode {
         DiagnosticCode::TooManyDiagnostics,
     ];
 
-    /// Whether this category is an error or a warning (spec §3.12 f).
+    /// Whether this category is an error, a warning or a note (spec §3.12 f).
     pub fn severity(self) -> Severity {
         use DiagnosticCode::*;
         match self {
@@ -292,7 +296,7 @@ impl Diagnostic {
 }
 
 impl fmt::Display for Diagnostic {
-    /// `LINE:COL: error|warning: message` (spec §3.12 f).
+    /// `LINE:COL: error|warning|note: message` (spec §3.12 f).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,

@@ -50,9 +50,9 @@ use crate::spec::ModelSpec;
 /// The result of parsing a script.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Parsed {
-    /// The model, when the script has no error (warnings do not block it).
+    /// The model, when the script has no error (warnings and notes do not block it).
     pub spec: Option<ModelSpec>,
-    /// Every error and warning, sorted by line and column.
+    /// Every error, warning and note, sorted by line and column.
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -69,7 +69,16 @@ impl Parsed {
 
     /// The warnings.
     pub fn warnings(&self) -> impl Iterator<Item = &Diagnostic> {
-        self.diagnostics.iter().filter(|d| !d.is_error())
+        self.diagnostics
+            .iter()
+            .filter(|d| d.severity == Severity::Warning)
+    }
+
+    /// The notes: forms accepted as written, with the modern way to write them (legacy syntax).
+    pub fn notes(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.diagnostics
+            .iter()
+            .filter(|d| d.severity == Severity::Note)
     }
 
     /// The spec, or every diagnostic when there is an error.
