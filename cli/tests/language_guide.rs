@@ -27,7 +27,10 @@ fn guide_diagnostics_are_what_check_prints() {
         let [(tag, script, line), (next, shown, _)] = pair else {
             continue;
         };
-        let is_example = matches!(tag.as_str(), "mims" | "mims-error" | "mims-warning");
+        let is_example = matches!(
+            tag.as_str(),
+            "mims" | "mims-error" | "mims-warning" | "mims-note"
+        );
         if !is_example || next != "text" || !shown.starts_with("model.mdl:") {
             continue;
         }

@@ -1,6 +1,6 @@
 //! The examples of the language guide, `docs/LANGUAGE.md`, are real: every ```mims block parses
-//! without a diagnostic, every ```mims-error block has an error and every ```mims-warning block
-//! only warnings; the ```text block that follows an error or warning example is exactly what
+//! without a diagnostic, every ```mims-error block has an error, every ```mims-warning block
+//! only warnings (and maybe notes) and every ```mims-note block only notes; the ```text block that follows an error or warning example is exactly what
 //! the parser reports (in `ressort check`'s `model.mdl:LINE:COL: …` form); and every diagnostic
 //! code is documented.
 
@@ -64,18 +64,28 @@ fn error_and_warning_examples_report_what_the_guide_shows() {
     let all = blocks();
     let mut checked = 0;
     for (i, b) in all.iter().enumerate() {
-        let errors = match b.tag.as_str() {
-            "mims-error" => true,
-            "mims-warning" => false,
-            _ => continue,
-        };
+        if !matches!(b.tag.as_str(), "mims-error" | "mims-warning" | "mims-note") {
+            continue;
+        }
         let p = parse(&b.text);
         let where_ = format!("LANGUAGE.md line {}:\n{}", b.line, b.text);
-        if errors {
-            assert!(p.errors().next().is_some(), "{where_}: no error");
-        } else {
-            assert!(p.spec.is_some(), "{where_}: has an error");
-            assert!(p.warnings().next().is_some(), "{where_}: no warning");
+        match b.tag.as_str() {
+            "mims-error" => assert!(p.errors().next().is_some(), "{where_}: no error"),
+            "mims-warning" => {
+                assert!(p.spec.is_some(), "{where_}: has an error");
+                assert!(p.warnings().next().is_some(), "{where_}: no warning");
+            }
+            _ => {
+                assert!(p.spec.is_some(), "{where_}: has an error");
+                assert!(p.warnings().next().is_none(), "{where_}: has a warning");
+                assert!(p.notes().next().is_some(), "{where_}: no note");
+                // The notes' modern form builds the same model without a note.
+                let spec = p.spec.clone().unwrap();
+                let printed = print(&spec);
+                let again = parse(&printed);
+                assert!(again.diagnostics.is_empty(), "{where_}: {printed}");
+                assert_eq!(again.spec, Some(spec), "{where_}");
+            }
         }
         let shown = all
             .get(i + 1)

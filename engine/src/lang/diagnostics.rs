@@ -7,11 +7,14 @@
 
 use std::fmt;
 
-/// How serious a diagnostic is. Errors block the model; warnings do not (spec §3.12 f).
+/// How serious a diagnostic is. Errors block the model; warnings and notes do not (spec
+/// §3.12 f). A note marks something accepted as written, such as a legacy form, with the
+/// modern way to write it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Severity {
     Error,
     Warning,
+    Note,
 }
 
 impl fmt::Display for Severity {
@@ -19,6 +22,7 @@ impl fmt::Display for Severity {
         f.write_str(match self {
             Severity::Error => "error",
             Severity::Warning => "warning",
+            Severity::Note => "note",
         })
     }
 }
@@ -126,11 +130,20 @@ pub enum DiagnosticCode {
     ScopeAlreadyOpen,
     /// More diagnostics than the front end records; the rest are counted but not listed.
     TooManyDiagnostics,
+
+    // ---- notes ----------------------------------------------------------------------------
+    /// A connection point in the legacy proxy syntax of the MIMS proxy branch, a bare macro
+    /// label whose coordinates follow it or end the line (`@in1 frcInput @s 0.3`, `@c contact
+    /// @me @m K Z 0. u:w`); it is read as the bracket form (spec §2.8, §3.14).
+    LegacyProxySyntax,
+    /// A macro without its trailing velocity (legacy MIMS, `@s string 50 1. 0.6 0.01 0.`); the
+    /// velocity is 0 (spec §2.7, §3.14).
+    LegacyMacroVelocity,
 }
 
 impl DiagnosticCode {
-    /// Every category, in declaration order (errors first, then warnings).
-    pub const ALL: [DiagnosticCode; 40] = [
+    /// Every category, in declaration order (errors first, then warnings, then notes).
+    pub const ALL: [DiagnosticCode; 42] = [
         DiagnosticCode::InvalidUtf8,
         DiagnosticCode::UnterminatedBracket,
         DiagnosticCode::NestedBracket,
@@ -171,12 +184,15 @@ impl DiagnosticCode {
         DiagnosticCode::ScopeNotOpen,
         DiagnosticCode::ScopeAlreadyOpen,
         DiagnosticCode::TooManyDiagnostics,
+        DiagnosticCode::LegacyProxySyntax,
+        DiagnosticCode::LegacyMacroVelocity,
     ];
 
-    /// Whether this category is an error or a warning (spec §3.12 f).
+    /// Whether this category is an error, a warning or a note (spec §3.12 f).
     pub fn severity(self) -> Severity {
         use DiagnosticCode::*;
         match self {
+            LegacyProxySyntax | LegacyMacroVelocity => Severity::Note,
             PlusSeparator | IgnoredCommandLike | UnknownDirective | ScopeNotOpen
             | ScopeAlreadyOpen | TooManyDiagnostics => Severity::Warning,
             _ => Severity::Error,
@@ -227,6 +243,8 @@ impl DiagnosticCode {
             ScopeNotOpen => "scope-not-open",
             ScopeAlreadyOpen => "scope-already-open",
             TooManyDiagnostics => "too-many-diagnostics",
+            LegacyProxySyntax => "legacy-proxy-syntax",
+            LegacyMacroVelocity => "legacy-macro-velocity",
         }
     }
 }
@@ -292,7 +310,7 @@ impl Diagnostic {
 }
 
 impl fmt::Display for Diagnostic {
-    /// `LINE:COL: error|warning: message` (spec §3.12 f).
+    /// `LINE:COL: error|warning|note: message` (spec §3.12 f).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,

@@ -16,7 +16,8 @@
 //! The language is a superset of MIMS4Max (§3.12 a): `#` comments anywhere, scientific
 //! notation, expressions with the functions of §3.5, legacy `massG`, two-parameter `spring` and
 //! `nlSpring`, `~samplerate raw|scaled`, nested and overlapping buffer scopes (§3.10), legacy
-//! trailing buffer tags (§6.4), and the `~generate` directive, which expands a topology
+//! trailing buffer tags (§6.4), the proxy branch's bare connection points and macros without
+//! velocity (read as the modern form, with a note; §3.14), and the `~generate` directive, which expands a topology
 //! generator of §4 inline into explicit, addressable elements:
 //!
 //! ```
@@ -35,6 +36,7 @@
 mod diagnostics;
 mod expr_parser;
 mod generate;
+mod legacy;
 mod lexer;
 mod parser;
 mod printer;
@@ -50,9 +52,9 @@ use crate::spec::ModelSpec;
 /// The result of parsing a script.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Parsed {
-    /// The model, when the script has no error (warnings do not block it).
+    /// The model, when the script has no error (warnings and notes do not block it).
     pub spec: Option<ModelSpec>,
-    /// Every error and warning, sorted by line and column.
+    /// Every error, warning and note, sorted by line and column.
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -69,7 +71,16 @@ impl Parsed {
 
     /// The warnings.
     pub fn warnings(&self) -> impl Iterator<Item = &Diagnostic> {
-        self.diagnostics.iter().filter(|d| !d.is_error())
+        self.diagnostics
+            .iter()
+            .filter(|d| d.severity == Severity::Warning)
+    }
+
+    /// The notes: forms accepted as written, with the modern way to write them (legacy syntax).
+    pub fn notes(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.diagnostics
+            .iter()
+            .filter(|d| d.severity == Severity::Note)
     }
 
     /// The spec, or every diagnostic when there is an error.

@@ -12,6 +12,7 @@ use super::expr_parser::{
     Symbol, Symbols,
 };
 use super::generate::{self, GenRequest, Read, MAX_GENERATED_ELEMENTS};
+use super::legacy;
 use super::lexer::{is_blank, split_items, split_lines, tokenize, TokKind, Token};
 use super::Parsed;
 use crate::expr::{Expr, Func};
@@ -1010,6 +1011,22 @@ impl Builder<'_> {
         let Some(args) = args else {
             return; // a malformed tag, reported
         };
+        // The legacy syntax of the MIMS proxy branch (spec §3.14), read as its modern form.
+        let form = match shape {
+            Shape::Law(_) => legacy::Form::Endpoints(2),
+            Shape::FrcInput | Shape::PosOutput | Shape::FrcOutput => legacy::Form::Endpoints(1),
+            Shape::Macro(_) => legacy::Form::Macro,
+            _ => legacy::Form::Other,
+        };
+        let place = legacy::Place {
+            line: item.line,
+            label: &label,
+        };
+        let read = legacy::read(form, (min, max), args, self.symbols, place, &mut self.diags);
+        let (args, points) = match &read {
+            Some(r) => (r.args.as_slice(), r.points.as_slice()),
+            None => (args, &[][..]),
+        };
         if args.len() < min || args.len() > max {
             self.report_count(shape, &keyword, kw, args, (min, max, signature), at);
             return;
@@ -1021,7 +1038,7 @@ impl Builder<'_> {
                 }
                 return;
             }
-            _ => self.element(shape, &label, first, args, at),
+            _ => self.element(shape, &label, first, args, points, at),
         };
         let Some(kind) = kind else {
             return;
@@ -1345,6 +1362,34 @@ impl Builder<'_> {
         }
     }
 
+    /// The endpoint in argument slot `slot`: a legacy bare connection point when `points` has
+    /// one there (spec §2.8, §3.14; the same endpoint as the bracket form), otherwise
+    /// [`Self::endpoint`].
+    fn slot_endpoint(
+        &mut self,
+        args: &[Token],
+        slot: usize,
+        points: &[legacy::Point],
+        at: At<'_>,
+    ) -> Option<Endpoint> {
+        let Some(p) = points.iter().find(|p| p.slot == slot) else {
+            return self.endpoint(args.get(slot)?, at);
+        };
+        let coords: Vec<Option<Expr>> = p.coords.iter().map(|t| self.expr(t, at)).collect();
+        let target = p.target.clone();
+        match <[Option<Expr>; 2]>::try_from(coords) {
+            Ok([u, w]) => Some(Endpoint::Surface {
+                target,
+                u: u?,
+                w: w?,
+            }),
+            Err(mut one) => Some(Endpoint::Line {
+                target,
+                alpha: one.pop()??,
+            }),
+        }
+    }
+
     fn connection_point(&mut self, t: &Token, at: At<'_>) -> Option<Endpoint> {
         let items = split_items(&t.text);
         let &(s, e) = items.first()?;
@@ -1632,12 +1677,15 @@ impl Builder<'_> {
         })
     }
 
+    /// Builds an element from arguments of an accepted count. `points` are the legacy bare
+    /// connection points found in the endpoint slots (see [`legacy::read`]).
     fn element(
         &mut self,
         shape: Shape,
         label: &str,
         first: &Token,
         args: &[Token],
+        points: &[legacy::Point],
         at: At<'_>,
     ) -> Option<ElementKind> {
         let n = args.len();
@@ -1696,8 +1744,8 @@ impl Builder<'_> {
                 })
             }
             Shape::Law(kind) => {
-                let a = self.endpoint(args.first()?, at);
-                let b = self.endpoint(args.get(1)?, at);
+                let a = self.slot_endpoint(args, 0, points, at);
+                let b = self.slot_endpoint(args, 1, points, at);
                 let params: Vec<Option<Expr>> = args
                     .get(2..)
                     .unwrap_or(&[])
@@ -1785,7 +1833,7 @@ impl Builder<'_> {
                     "out"
                 };
                 let channel = self.channel(label, prefix, first, at);
-                let target = self.endpoint(args.first()?, at);
+                let target = self.slot_endpoint(args, 0, points, at);
                 let (channel, target) = (channel?, target?);
                 Some(match shape {
                     Shape::FrcInput => ElementKind::FrcInput { channel, target },
