@@ -851,6 +851,10 @@ impl Vst3Plugin for Ressort {
         Vst3SubCategory::Synth,
         Vst3SubCategory::Fx,
     ];
+    /// VST3 delivers MIDI controllers as proxy parameters, one per controller and channel,
+    /// and JUCE-based hosts list every one (2,080 for all of them). The plugin reads pitch
+    /// bend (129) only; a controller it starts to read goes in this list.
+    const VST3_MIDI_CONTROLLERS: &'static [u8] = &[129];
 }
 
 nice_export_clap!(Ressort);

@@ -33,10 +33,31 @@ pub trait Vst3Plugin: Plugin {
     /// truncated.
     const VST3_SUBCATEGORIES: &'static [Vst3SubCategory];
 
+    /// The MIDI controllers that reach the plugin in VST3, where MIDI CCs, channel pressure
+    /// and pitch bend arrive as parameters (`IMidiMapping`). With
+    /// [`MidiConfig::MidiCCs`][crate::prelude::MidiConfig::MidiCCs] the wrapper adds one hidden,
+    /// read-only proxy parameter per listed controller and MIDI channel: CC numbers 0 to 127,
+    /// 128 for channel pressure and 129 for pitch bend. Hosts such as JUCE's list every
+    /// proxy, so a plugin that uses a few controllers should list just those (Ressort patch;
+    /// the published wrapper always adds all 130 × 16).
+    const VST3_MIDI_CONTROLLERS: &'static [u8] = &ALL_VST3_MIDI_CONTROLLERS;
+
     /// [`VST3_CLASS_ID`][Self::VST3_CLASS_ID`] in the correct order for the current platform so
     /// projects and presets can be shared between platforms. This should not be overridden.
     const PLATFORM_VST3_CLASS_ID: [u8; 16] = swap_vst3_uid_byte_order(Self::VST3_CLASS_ID);
 }
+
+/// Every controller a VST3 MIDI proxy parameter can stand for: CCs 0 to 127, channel pressure
+/// (128) and pitch bend (129).
+pub const ALL_VST3_MIDI_CONTROLLERS: [u8; 130] = {
+    let mut all = [0u8; 130];
+    let mut i = 0;
+    while i < all.len() {
+        all[i] = i as u8;
+        i += 1;
+    }
+    all
+};
 
 #[cfg(not(target_os = "windows"))]
 const fn swap_vst3_uid_byte_order(uid: [u8; 16]) -> [u8; 16] {
