@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what Ressort needs on a fresh Debian machine: the system packages of the plugin shell
-# (ALSA, JACK, X11, GL) and the crates of the workspace. Safe to run again: it installs only what
-# is missing.
+# (ALSA, JACK, X11, GL), Python's venv for the VST3 host tests, and the crates of the
+# workspace. Safe to run again: it installs only what is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -22,6 +22,12 @@ packages=(
   xvfb
   libgl1-mesa-dri
 )
+# The VST3 host tests run pedalboard and DawDreamer (PyPI) in a virtual environment.
+if ! command -v python3 >/dev/null; then
+  packages+=(python3 python3-venv python3-pip)
+elif ! python3 -m venv --help >/dev/null 2>&1; then
+  packages+=(python3-venv)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

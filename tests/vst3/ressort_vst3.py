@@ -1,0 +1,81 @@
+"""Helpers for the VST3 end-to-end tests: where the bundle is, plugin states as .vstpreset
+files, and the measures the tests apply to rendered audio."""
+
+import json
+import os
+import struct
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[2]
+
+#: The plugin's VST3 class ID (`Vst3Plugin::VST3_CLASS_ID`), as 16 bytes.
+CLASS_ID = b"RessortMassInter"
+
+
+def bundle() -> Path:
+    """The VST3 bundle under test: $RESSORT_VST3, or the one `cargo xtask bundle` made."""
+    path = Path(os.environ.get("RESSORT_VST3", REPO / "target" / "bundled" / "Ressort.vst3"))
+    if not path.exists():
+        raise FileNotFoundError(
+            f"{path} does not exist: run `cargo xtask bundle ressort-plugin` first"
+        )
+    return path
+
+
+def model_state(name: str, script: str, params: dict | None = None) -> bytes:
+    """A plugin state (nice-plug's JSON) that loads `script` as the running model and sets
+    the given float parameters (plain values by id); the others keep their defaults."""
+    state = {
+        "version": "0.1.0",
+        "params": {id: {"f32": float(v)} for id, v in (params or {}).items()},
+        "fields": {"model": json.dumps({"name": name, "script": script})},
+    }
+    return json.dumps(state).encode()
+
+
+def write_vstpreset(path: Path, component_state: bytes) -> Path:
+    """Writes a VST3 preset file (the SDK's PresetFile layout: header, one 'Comp' chunk, the
+    chunk list) holding `component_state`."""
+    header_size = 4 + 4 + 32 + 8
+    class_id = CLASS_ID.hex().upper().encode()
+    list_offset = header_size + len(component_state)
+    data = bytearray()
+    data += b"VST3" + struct.pack("<i", 1) + class_id + struct.pack("<q", list_offset)
+    data += component_state
+    data += b"List" + struct.pack("<i", 1)
+    data += b"Comp" + struct.pack("<qq", header_size, len(component_state))
+    path.write_bytes(bytes(data))
+    return path
+
+
+def peak_frequency(signal: np.ndarray, sample_rate: float) -> float:
+    """The strongest spectral peak of `signal` (Hann window, parabolic interpolation on the
+    log magnitude), in Hz."""
+    x = np.asarray(signal, dtype=np.float64)
+    x = x - x.mean()
+    n = len(x)
+    spectrum = np.abs(np.fft.rfft(x * np.hanning(n)))
+    k = int(np.argmax(spectrum[1:-1])) + 1
+    a, b, c = np.log(spectrum[k - 1 : k + 2] + 1e-300)
+    delta = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) != 0 else 0.0
+    return (k + delta) * sample_rate / n
+
+
+def cents(f: float, reference: float) -> float:
+    return 1200.0 * np.log2(f / reference)
+
+
+def oscillator_frequency(m: float, k: float, sample_rate: float) -> float:
+    """The exact discrete law of a mass-spring oscillator (spec §5.3) for a script tuned at
+    44.1 kHz: K is scaled by (44100/SR)², and sin²(πf/SR) = K/4M."""
+    k_step = k * (44100.0 / sample_rate) ** 2
+    return sample_rate / np.pi * np.arcsin(np.sqrt(k_step / (4.0 * m)))
+
+
+def clicks(channels: int, frames: int, every: int, value: float) -> np.ndarray:
+    """A click train: `value` every `every` samples on every channel, from sample 0."""
+    audio = np.zeros((channels, frames), dtype=np.float32)
+    audio[:, ::every] = value
+    return audio

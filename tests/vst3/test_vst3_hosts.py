@@ -1,0 +1,248 @@
+"""End-to-end tests of Ressort.vst3 in two JUCE-based VST3 hosts, pedalboard and DawDreamer:
+loading, parameters by value, MIDI notes at their pitch, state restored into a fresh instance,
+and audio into the plugin striking the model.
+
+The bundle is the one the test command builds (`assert_process_allocs`: an allocation in
+process() aborts the host process, so these tests also check that in JUCE hosts).
+"""
+
+from pathlib import Path
+
+import dawdreamer as daw
+import mido
+import numpy as np
+import pedalboard
+import pytest
+
+from ressort_vst3 import (
+    bundle,
+    cents,
+    clicks,
+    model_state,
+    oscillator_frequency,
+    peak_frequency,
+    write_vstpreset,
+)
+
+SR = 48_000
+
+#: One oscillator (M = 1, K = 0.001, about 222 Hz) that MIDI notes strike directly.
+OSCILLATOR = """\
+# A single oscillator at about 222 Hz, struck directly by in1 (VST3 host tests).
+@o osc 1. 0.001 0.00001 0. 0.
+@in1 frcInput @o
+@out1 posOutput @o
+"""
+OSC_M, OSC_K = 1.0, 0.001
+
+#: A small membrane with two bound macros: a model other than the default for state tests.
+SMALL_MESH = """\
+# A 9 x 7 membrane struck by a hammer (VST3 state tests).
+@K param 0.08
+@Z param 0.002
+@mesh cornerMesh 9 7 1. K Z 0. 0.
+@gh ground 0.1
+@h mass 1. 0.1 0.
+@sh springDamper @gh @h 0.0001 0.05
+@hit contact [@mesh 0.3 0.2] @h 0.1 0.001
+@in1 frcInput @h
+@out1 posOutput [@mesh 0.75 0.6]
+@out2 posOutput [@mesh 0.4 0.5]
+"""
+
+#: A sidechain click that strikes the default model (Mesh 15x15: in1 pushes a hammer onto the
+#: membrane; a negative force moves it towards the membrane).
+STRIKE = -0.05
+
+#: The plugin's own parameters (before the MIDI pitch-bend proxies).
+PARAMETERS = [
+    "stiffness",
+    "damping",
+    "tune_st",
+    "output_gain_db",
+    "force_gain_db",
+    "position_gain_db",
+    "dc_filter",
+    "guard_tripped",
+] + [f"macro_{i}" for i in range(1, 17)]
+
+
+@pytest.fixture
+def preset_dir(tmp_path: Path) -> Path:
+    return tmp_path
+
+
+def preset(directory: Path, name: str, script: str, **params) -> str:
+    state = model_state(name, script, params)
+    return str(write_vstpreset(directory / f"{name}.vstpreset", state))
+
+
+def note(key: int, velocity: int = 100) -> list:
+    return [mido.Message("note_on", note=key, velocity=velocity, time=0.0)]
+
+
+# ------------------------------------------------------------------------------------------
+# pedalboard
+# ------------------------------------------------------------------------------------------
+
+
+def test_pedalboard_loads_the_plugin_with_its_parameters():
+    plugin = pedalboard.load_plugin(str(bundle()))
+    names = list(plugin.parameters.keys())
+    assert names[: len(PARAMETERS)] == PARAMETERS
+    # VST3 delivers pitch bend through one hidden proxy parameter per MIDI channel; the
+    # plugin lists no other MIDI controller proxies.
+    proxies = names[len(PARAMETERS) :]
+    assert proxies == [f"midi_ch_{c}_pitch_bend" for c in range(1, 17)], proxies
+    assert plugin.is_instrument
+
+
+def test_pedalboard_reads_and_sets_parameters_by_value():
+    plugin = pedalboard.load_plugin(str(bundle()))
+    assert plugin.stiffness == 1.0
+    assert plugin.output_gain_db == 24.0
+    plugin.stiffness = 4
+    assert plugin.stiffness == 4.0
+    assert plugin.parameters["stiffness"].raw_value == pytest.approx(0.75, abs=1e-6)
+    plugin.damping = 0.25
+    assert plugin.damping == 0.25
+    plugin.output_gain_db = -6
+    assert plugin.output_gain_db == -6.0
+    plugin.tune_st = 3
+    assert plugin.tune_st == 3.0
+    plugin.force_gain_db = -12.5
+    assert plugin.force_gain_db == -12.5
+
+
+def test_pedalboard_plays_midi_notes_at_their_pitch(preset_dir):
+    plugin = pedalboard.load_plugin(str(bundle()))
+    plugin.load_preset(preset(preset_dir, "oscillator", OSCILLATOR, output_gain=-20.0))
+    f0 = oscillator_frequency(OSC_M, OSC_K, SR)
+    # Note 60 is the model's key: it plays as written. Other notes follow the exact law.
+    for key, semitones in [(60, 0), (72, 12), (67, 7), (55, -5)]:
+        plugin.reset()
+        out = plugin(note(key), duration=1.0, sample_rate=SR)
+        assert np.isfinite(out).all()
+        assert np.abs(out).max() > 0.01, f"note {key} is silent"
+        f = peak_frequency(out[0], SR)
+        expected = f0 * 2 ** (semitones / 12)
+        print(f"note {key}: {f:.3f} Hz, expected {expected:.3f} Hz")
+        assert abs(cents(f, expected)) < 3.0, f"note {key}: {f:.3f} Hz, not {expected:.3f} Hz"
+
+
+def test_pedalboard_restores_state_bit_identically_into_a_fresh_instance(preset_dir):
+    first = pedalboard.load_plugin(str(bundle()))
+    first.load_preset(preset(preset_dir, "small-mesh", SMALL_MESH))
+    first.stiffness = 2
+    first.parameters["macro_1"].raw_value = 0.7
+    first.output_gain_db = 6
+    # JUCE hosts hand parameter changes to the plugin with the next audio block.
+    first(note(60), duration=0.1, sample_rate=SR)
+    state = first.raw_state
+
+    second = pedalboard.load_plugin(str(bundle()))
+    second.raw_state = state
+    assert second.raw_state == state
+    assert second.stiffness == 2.0
+    assert second.output_gain_db == 6.0
+
+    renders = []
+    for plugin in (first, second):
+        plugin.reset()
+        renders.append(plugin(note(64), duration=1.0, sample_rate=SR))
+    assert np.abs(renders[0]).max() > 1e-3
+    assert np.array_equal(renders[0], renders[1])
+    # The restored instance plays the small mesh, not the default model.
+    default = pedalboard.load_plugin(str(bundle()))
+    default.stiffness = 2
+    default.output_gain_db = 6
+    other = default(note(64), duration=1.0, sample_rate=SR)
+    assert not np.array_equal(renders[0], other)
+
+
+def test_pedalboard_audio_input_strikes_the_model():
+    # pedalboard's effect call feeds the plugin's first input bus: in VST3 that is the
+    # "Sidechain" bus, whose left channel is @in1.
+    plugin = pedalboard.load_plugin(str(bundle()))
+    struck = plugin(clicks(2, SR, SR // 10, STRIKE), SR)
+    assert struck.shape == (2, SR)
+    assert np.isfinite(struck).all()
+    plugin.reset()
+    silent = plugin(clicks(2, SR, SR // 10, 0.0), SR)
+    print(f"peak struck {np.abs(struck).max():.4f}, silent input {np.abs(silent).max():.2e}")
+    assert np.abs(silent).max() == 0.0
+    assert np.abs(struck).max() > 0.05
+    # Every click strikes: the output rises within 10 ms after each one.
+    for n in range(10):
+        start = n * SR // 10
+        window = struck[0, start : start + SR // 100]
+        assert np.abs(window).max() > 0.01, f"click {n} did not strike"
+
+
+# ------------------------------------------------------------------------------------------
+# DawDreamer
+# ------------------------------------------------------------------------------------------
+
+
+def render_dawdreamer(setup, seconds: float = 1.0) -> np.ndarray:
+    engine = daw.RenderEngine(SR, 512)
+    graph = setup(engine)
+    engine.load_graph(graph)
+    engine.render(seconds)
+    return engine.get_audio()
+
+
+def test_dawdreamer_loads_the_plugin_with_stereo_input_and_output():
+    engine = daw.RenderEngine(SR, 512)
+    plugin = engine.make_plugin_processor("ressort", str(bundle()))
+    assert plugin.get_num_input_channels() == 2
+    assert plugin.get_num_output_channels() == 2
+    names = [plugin.get_parameter_name(i) for i in range(plugin.get_plugin_parameter_size())]
+    assert names[:3] == ["Stiffness", "Damping", "Tune"]
+    assert len(names) == len(PARAMETERS) + 16
+
+
+def test_dawdreamer_sidechain_clicks_strike_the_model():
+    def with_clicks(value):
+        def setup(engine):
+            plugin = engine.make_plugin_processor("ressort", str(bundle()))
+            source = engine.make_playback_processor("clicks", clicks(2, SR, SR // 10, value))
+            return [(source, []), (plugin, ["clicks"])]
+
+        return setup
+
+    struck = render_dawdreamer(with_clicks(STRIKE))
+    silent = render_dawdreamer(with_clicks(0.0))
+    print(f"peak struck {np.abs(struck).max():.4f}, silent input {np.abs(silent).max():.2e}")
+    assert np.isfinite(struck).all()
+    assert np.abs(silent).max() == 0.0
+    assert np.abs(struck).max() > 0.05
+
+
+def test_dawdreamer_plays_a_preset_and_a_midi_note_at_its_pitch(preset_dir):
+    path = preset(preset_dir, "oscillator", OSCILLATOR, output_gain=-20.0)
+
+    def setup(engine):
+        plugin = engine.make_plugin_processor("ressort", str(bundle()))
+        assert plugin.load_vst3_preset(path)
+        plugin.add_midi_note(72, 100, 0.0, 0.5)
+        return [(plugin, [])]
+
+    out = render_dawdreamer(setup)
+    f = peak_frequency(out[0], SR)
+    expected = 2 * oscillator_frequency(OSC_M, OSC_K, SR)
+    print(f"note 72: {f:.3f} Hz, expected {expected:.3f} Hz")
+    assert abs(cents(f, expected)) < 3.0
+
+
+def test_dawdreamer_parameters_by_value():
+    def setup(engine):
+        plugin = engine.make_plugin_processor("ressort", str(bundle()))
+        # DawDreamer sets normalized values; the plugin's text says what they mean.
+        plugin.set_parameter(0, 0.75)
+        assert plugin.get_parameter_text(0) == "4.00"
+        plugin.set_parameter(3, (-6.0 + 40.0) / 100.0)
+        assert plugin.get_parameter_text(3) == "-6.0"
+        return [(plugin, [])]
+
+    render_dawdreamer(setup, seconds=0.1)
