@@ -554,6 +554,21 @@ impl Plugin for Ressort {
                 aux_outputs: &[],
             },
         },
+        // Effect without a sidechain: lets a host that feeds only the main bus switch the
+        // sidechain off (pedalboard does when it can).
+        AudioIOLayout {
+            main_input_channels: NonZeroU32::new(2),
+            main_output_channels: NonZeroU32::new(2),
+            aux_input_ports: &[],
+            aux_output_ports: &[],
+            names: PortNames {
+                layout: Some("Effect"),
+                main_input: Some("Input"),
+                main_output: Some("Output"),
+                aux_inputs: &[],
+                aux_outputs: &[],
+            },
+        },
     ];
 
     const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;

@@ -269,8 +269,9 @@ fn plugin_describes_its_ports_and_parameters() {
     assert_eq!(outputs.len(), 1);
     assert!(outputs[0].is_main);
     assert_eq!(outputs[0].channels, 2);
-    assert_eq!(configs.len(), 2);
+    assert_eq!(configs.len(), 3);
     assert!(configs.iter().any(|c| c == "Effect with sidechain"));
+    assert!(configs.iter().any(|c| c == "Effect"));
     assert_eq!(notes.len(), 1, "one note input");
     assert!(notes[0].dialects & 1 != 0, "note input accepts CLAP notes");
     assert!(notes[0].dialects & 2 != 0, "note input accepts MIDI");

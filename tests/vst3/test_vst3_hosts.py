@@ -50,6 +50,17 @@ SMALL_MESH = """\
 @out2 posOutput [@mesh 0.4 0.5]
 """
 
+def routed_oscillator(source: str) -> str:
+    """The oscillator, struck by in1, with in1 fed by one host channel (`~route`)."""
+    return f"""\
+# An oscillator struck by in1, which the host channel {source} feeds (VST3 layout tests).
+@o osc 1. 0.001 0.00001 0. 0.
+@in1 frcInput @o
+@out1 posOutput @o
+~route in1 {source}
+"""
+
+
 #: A sidechain click that strikes the default model (Mesh 15x15: in1 pushes a hammer onto the
 #: membrane; a negative force moves it towards the membrane).
 STRIKE = -0.05
@@ -161,8 +172,8 @@ def test_pedalboard_restores_state_bit_identically_into_a_fresh_instance(preset_
 
 
 def test_pedalboard_audio_input_strikes_the_model():
-    # pedalboard's effect call feeds the plugin's first input bus: in VST3 that is the
-    # "Sidechain" bus, whose left channel is @in1.
+    # pedalboard enables the main input and switches the sidechain off where it can: the
+    # plugin runs in its "Effect" layout, and the main input's left channel is @in1.
     plugin = pedalboard.load_plugin(str(bundle()))
     struck = plugin(clicks(2, SR, SR // 10, STRIKE), SR)
     assert struck.shape == (2, SR)
@@ -246,3 +257,45 @@ def test_dawdreamer_parameters_by_value():
         return [(plugin, [])]
 
     render_dawdreamer(setup, seconds=0.1)
+
+
+def test_pedalboard_feeds_the_main_input_of_the_effect_layout(preset_dir):
+    peaks = {}
+    for source in ("main_left", "sidechain_left"):
+        plugin = pedalboard.load_plugin(str(bundle()))
+        plugin.load_preset(preset(preset_dir, source, routed_oscillator(source), output_gain=-20.0))
+        out = plugin(clicks(2, SR, SR // 10, 0.05), SR)
+        peaks[source] = float(np.abs(out).max())
+    print(f"peaks by the channel feeding in1: {peaks}")
+    assert peaks["main_left"] > 0.01
+    assert peaks["sidechain_left"] == 0.0
+
+
+def test_dawdreamer_negotiates_the_instrument_and_the_effect_layout(preset_dir):
+    # DawDreamer's plugin input takes its channels from the first active input busses. As
+    # loaded, the main input is off (the VST3's default is the instrument layout), so they go
+    # to the sidechain; with every bus enabled the plugin runs "Effect with sidechain" and
+    # they go to the main input. A model whose in1 listens to one channel tells which.
+    peaks = {}
+    for enable_all in (False, True):
+        for source in ("main_left", "sidechain_left"):
+            path = preset(preset_dir, source, routed_oscillator(source), output_gain=-20.0)
+
+            def setup(engine):
+                plugin = engine.make_plugin_processor("ressort", str(bundle()))
+                assert plugin.load_vst3_preset(path)
+                if enable_all:
+                    plugin.enable_all_buses()
+                source_clicks = engine.make_playback_processor(
+                    "clicks", clicks(2, SR, SR // 10, 0.05)
+                )
+                return [(source_clicks, []), (plugin, ["clicks"])]
+
+            out = render_dawdreamer(setup)
+            assert np.isfinite(out).all()
+            peaks[(enable_all, source)] = float(np.abs(out).max())
+    print(f"peaks by (every bus enabled, channel feeding in1): {peaks}")
+    assert peaks[(False, "sidechain_left")] > 0.01
+    assert peaks[(False, "main_left")] == 0.0
+    assert peaks[(True, "main_left")] > 0.01
+    assert peaks[(True, "sidechain_left")] == 0.0

@@ -1,6 +1,8 @@
 #[macro_use]
 mod util;
 
+mod busses;
+
 mod context;
 mod factory;
 mod inner;

@@ -98,6 +98,9 @@ pub(crate) struct WrapperInner<P: Vst3Plugin> {
     /// IO layout is chosen as the default. Because of the way VST3 works it's not possible to
     /// change the number of busses from that default, only the channel counts can change.
     pub current_audio_io_layout: AtomicCell<AudioIOLayout>,
+    /// The host's bus arrangements and activations (Ressort patch, see `busses`). The layout in
+    /// use follows them while the plugin is inactive.
+    pub host_busses: Mutex<super::busses::HostBusses>,
     /// The current buffer configuration, containing the sample rate and the maximum block size.
     /// Will be set in `IAudioProcessor::setupProcessing()`.
     pub current_buffer_config: AtomicCell<Option<BufferConfig>>,
@@ -356,6 +359,7 @@ impl<P: Vst3Plugin> WrapperInner<P> {
             current_audio_io_layout: AtomicCell::new(
                 P::AUDIO_IO_LAYOUTS.first().copied().unwrap_or_default(),
             ),
+            host_busses: Mutex::new(super::busses::HostBusses::new(P::AUDIO_IO_LAYOUTS)),
             current_buffer_config: AtomicCell::new(None),
             current_process_mode: AtomicCell::new(ProcessMode::Realtime),
             #[cfg(feature = "editor")]

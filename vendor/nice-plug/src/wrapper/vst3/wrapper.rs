@@ -8,7 +8,6 @@ use nice_plug_core::params::ParamFlags;
 use nice_plug_core::plugin::ProcessStatus;
 use std::ffi::c_void;
 use std::mem::{self, MaybeUninit};
-use std::num::NonZeroU32;
 use std::ptr::NonNull;
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
@@ -40,6 +39,7 @@ use vst3::Steinberg::{
 use vst3::{Class, ComRef};
 use widestring::U16CStr;
 
+use super::busses;
 use super::inner::{ProcessEvent, WrapperInner};
 use super::note_expressions;
 use super::util::{VST3_MIDI_CCS, VST3_MIDI_PARAMS_START, u16strlcpy};
@@ -130,30 +130,13 @@ impl<P: Vst3Plugin> IComponentTrait for Wrapper<P> {
         type_: vst3::Steinberg::Vst::MediaType,
         dir: vst3::Steinberg::Vst::BusDirection,
     ) -> int32 {
-        let current_audio_io_layout = self.inner.current_audio_io_layout.load();
-
-        // A plugin has a main input and output bus if the default number of channels is non-zero,
-        // and a plugin can also have auxiliary input and output busses
         match type_ {
+            // Ressort patch: the union of the layouts' busses (see `busses`).
             x if x == K_MEDIA_TYPE_AUDIO && dir == K_BUS_DIRECTION_INPUT => {
-                let main_busses = if current_audio_io_layout.main_input_channels.is_some() {
-                    1
-                } else {
-                    0
-                };
-                let aux_busses = current_audio_io_layout.aux_input_ports.len() as i32;
-
-                main_busses + aux_busses
+                busses::count(P::AUDIO_IO_LAYOUTS, true) as i32
             }
             x if x == K_MEDIA_TYPE_AUDIO && dir == K_BUS_DIRECTION_OUTPUT => {
-                let main_busses = if current_audio_io_layout.main_output_channels.is_some() {
-                    1
-                } else {
-                    0
-                };
-                let aux_busses = current_audio_io_layout.aux_output_ports.len() as i32;
-
-                main_busses + aux_busses
+                busses::count(P::AUDIO_IO_LAYOUTS, false) as i32
             }
             x if x == K_MEDIA_TYPE_EVENT
                 && dir == K_BUS_DIRECTION_INPUT
@@ -180,86 +163,37 @@ impl<P: Vst3Plugin> IComponentTrait for Wrapper<P> {
     ) -> tresult {
         check_null_ptr!(info);
 
-        let current_audio_io_layout = self.inner.current_audio_io_layout.load();
-
         match (type_, dir, index) {
-            (t, d, _) if t == K_MEDIA_TYPE_AUDIO && d == K_BUS_DIRECTION_INPUT => {
+            // Ressort patch: the union of the layouts' busses, active by default when the
+            // first layout has them (see `busses`).
+            (t, d, _)
+                if t == K_MEDIA_TYPE_AUDIO
+                    && (d == K_BUS_DIRECTION_INPUT || d == K_BUS_DIRECTION_OUTPUT) =>
+            {
+                let Some(bus) = (index >= 0)
+                    .then(|| busses::describe(P::AUDIO_IO_LAYOUTS, d == K_BUS_DIRECTION_INPUT, index as usize))
+                    .flatten()
+                else {
+                    return kInvalidArgument;
+                };
                 unsafe { *info = mem::zeroed() };
 
                 let info = unsafe { &mut *info };
                 info.mediaType = K_MEDIA_TYPE_AUDIO;
                 info.direction = dir;
+                info.busType = if bus.main { K_BUS_TYPE_MAIN } else { K_BUS_TYPE_AUX };
+                info.channelCount = bus.channels as i32;
+                u16strlcpy(&mut info.name, &bus.name);
                 #[allow(clippy::unnecessary_cast)]
                 {
-                    info.flags = vst3::Steinberg::Vst::BusInfo_::BusFlags_::kDefaultActive as u32;
+                    info.flags = if bus.default_active {
+                        vst3::Steinberg::Vst::BusInfo_::BusFlags_::kDefaultActive as u32
+                    } else {
+                        0
+                    };
                 }
 
-                let has_main_input = current_audio_io_layout.main_input_channels.is_some();
-                let aux_input_start_idx = if has_main_input { 1 } else { 0 };
-                let aux_input_idx = (index - aux_input_start_idx).max(0) as usize;
-                if index == 0 && has_main_input {
-                    info.busType = K_BUS_TYPE_MAIN;
-                    info.channelCount =
-                        current_audio_io_layout.main_input_channels.unwrap().get() as i32;
-                    u16strlcpy(&mut info.name, &current_audio_io_layout.main_input_name());
-
-                    kResultOk
-                } else if aux_input_idx < current_audio_io_layout.aux_input_ports.len() {
-                    info.busType = K_BUS_TYPE_AUX;
-                    info.channelCount =
-                        current_audio_io_layout.aux_input_ports[aux_input_idx].get() as i32;
-                    u16strlcpy(
-                        &mut info.name,
-                        &current_audio_io_layout
-                            .aux_input_name(aux_input_idx)
-                            .expect("Out of bounds auxiliary input port"),
-                    );
-
-                    kResultOk
-                } else {
-                    kInvalidArgument
-                }
-            }
-            (t, d, _) if t == K_MEDIA_TYPE_AUDIO && d == K_BUS_DIRECTION_OUTPUT => {
-                unsafe { *info = mem::zeroed() };
-
-                let info = unsafe { &mut *info };
-                info.mediaType = K_MEDIA_TYPE_AUDIO;
-                info.direction = dir;
-                #[allow(clippy::unnecessary_cast)]
-                {
-                    info.flags = vst3::Steinberg::Vst::BusInfo_::BusFlags_::kDefaultActive as u32;
-                }
-
-                let has_main_output = current_audio_io_layout.main_output_channels.is_some();
-                let aux_output_start_idx = if has_main_output { 1 } else { 0 };
-                let aux_output_idx = (index - aux_output_start_idx).max(0) as usize;
-                if index == 0 && has_main_output {
-                    info.busType = K_BUS_TYPE_MAIN;
-                    // NOTE: See above, this becomes a 0 channel output if the plugin doesn't have a
-                    //       main output
-                    info.channelCount = current_audio_io_layout
-                        .main_output_channels
-                        .map(NonZeroU32::get)
-                        .unwrap_or_default() as i32;
-                    u16strlcpy(&mut info.name, &current_audio_io_layout.main_output_name());
-
-                    kResultOk
-                } else if aux_output_idx < current_audio_io_layout.aux_output_ports.len() {
-                    info.busType = K_BUS_TYPE_AUX;
-                    info.channelCount =
-                        current_audio_io_layout.aux_output_ports[aux_output_idx].get() as i32;
-                    u16strlcpy(
-                        &mut info.name,
-                        &current_audio_io_layout
-                            .aux_output_name(aux_output_idx)
-                            .expect("Out of bounds auxiliary output port"),
-                    );
-
-                    kResultOk
-                } else {
-                    kInvalidArgument
-                }
+                kResultOk
             }
             (t, d, 0)
                 if t == K_MEDIA_TYPE_EVENT
@@ -349,40 +283,31 @@ impl<P: Vst3Plugin> IComponentTrait for Wrapper<P> {
         type_: vst3::Steinberg::Vst::MediaType,
         dir: vst3::Steinberg::Vst::BusDirection,
         index: int32,
-        _state: TBool,
+        state: TBool,
     ) -> tresult {
-        let current_audio_io_layout = self.inner.current_audio_io_layout.load();
-
-        // We don't support this, but the validator will get very angry with us if we let it know
-        // that
         match (type_, dir, index) {
-            (t, d, _) if t == K_MEDIA_TYPE_AUDIO && d == K_BUS_DIRECTION_INPUT => {
-                let main_busses = if current_audio_io_layout.main_input_channels.is_some() {
-                    1
-                } else {
-                    0
-                };
-                let aux_busses = current_audio_io_layout.aux_input_ports.len() as i32;
-
-                if (0..main_busses + aux_busses).contains(&index) {
-                    kResultOk
-                } else {
-                    kInvalidArgument
+            // Ressort patch: activations choose the layout (see `busses`), while inactive.
+            (t, d, _)
+                if t == K_MEDIA_TYPE_AUDIO
+                    && (d == K_BUS_DIRECTION_INPUT || d == K_BUS_DIRECTION_OUTPUT) =>
+            {
+                let input = d == K_BUS_DIRECTION_INPUT;
+                if index < 0 || index as usize >= busses::count(P::AUDIO_IO_LAYOUTS, input) {
+                    return kInvalidArgument;
                 }
-            }
-            (t, d, _) if t == K_MEDIA_TYPE_AUDIO && d == K_BUS_DIRECTION_OUTPUT => {
-                let main_busses = if current_audio_io_layout.main_output_channels.is_some() {
-                    1
+                let mut host = self.inner.host_busses.lock();
+                let active = if input {
+                    &mut host.input_active
                 } else {
-                    0
+                    &mut host.output_active
                 };
-                let aux_busses = current_audio_io_layout.aux_output_ports.len() as i32;
-
-                if (0..main_busses + aux_busses).contains(&index) {
-                    kResultOk
-                } else {
-                    kInvalidArgument
+                active[index as usize] = state != 0;
+                if !self.inner.is_processing.load(Ordering::SeqCst) {
+                    if let Some(layout) = host.layout(P::AUDIO_IO_LAYOUTS) {
+                        self.inner.current_audio_io_layout.store(layout);
+                    }
                 }
+                kResultOk
             }
             (t, d, 0)
                 if t == K_MEDIA_TYPE_EVENT
@@ -414,6 +339,10 @@ impl<P: Vst3Plugin> IComponentTrait for Wrapper<P> {
                 }
 
                 let mut activate_context = self.inner.make_activate_context();
+                // Ressort patch: the layout of the busses the host made present (see `busses`).
+                if let Some(layout) = self.inner.host_busses.lock().layout(P::AUDIO_IO_LAYOUTS) {
+                    self.inner.current_audio_io_layout.store(layout);
+                }
                 let audio_io_layout = self.inner.current_audio_io_layout.load();
 
                 // In the case a host misbehaves and tries to activate the plugin without waiting for the
@@ -834,85 +763,35 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
             return kInvalidArgument;
         }
 
-        // nice-plug no longer supports flexible IO layouts. Instead we'll try to find an audio IO
-        // layout that matches the host's requested layout.
-        let matching_layout = P::AUDIO_IO_LAYOUTS
-            .iter()
-            .find(|layout| {
-                // If the number of ports/busses doesn't match then we can immediately discard the
-                // layout. VST3 doesn't allow for optional switchable ports like CLAP does. Only the
-                // channel counts can change.
-                let num_layout_ins = if layout.main_input_channels.is_some() {
-                    1
-                } else {
-                    0
-                } + layout.aux_input_ports.len();
-                let num_layout_outs = if layout.main_output_channels.is_some() {
-                    1
-                } else {
-                    0
-                } + layout.aux_output_ports.len();
-                if num_ins as usize != num_layout_ins || num_outs as usize != num_layout_outs {
-                    return false;
-                }
-
-                // NOTE: We completely ignore the speaker arrangements and only look at the channel
-                //       counts here. This may cause issues at some point, but it works for now.
-                // Auxiliary busses follow the main bus when there is one (Ressort patch: the
-                // published code had these two indices swapped, and read past the host's
-                // array for a layout without a main input).
-                let has_main_input = layout.main_input_channels.is_some();
-                let aux_input_start_idx = if has_main_input { 1 } else { 0 };
-                if has_main_input
-                    && unsafe {
-                        (*inputs).count_ones() != layout.main_input_channels.unwrap().get()
-                    }
-                {
-                    return false;
-                }
-                for (aux_input_idx, channel_count) in layout.aux_input_ports.iter().enumerate() {
-                    if unsafe {
-                        (*inputs.add(aux_input_idx + aux_input_start_idx)).count_ones()
-                            != channel_count.get()
-                    } {
-                        return false;
-                    }
-                }
-
-                let has_main_output = layout.main_output_channels.is_some();
-                let aux_output_start_idx = if has_main_output { 1 } else { 0 };
-                if unsafe {
-                    (*outputs).count_ones()
-                        != layout
-                            .main_output_channels
-                            .map(NonZeroU32::get)
-                            .unwrap_or_default()
-                } {
-                    return false;
-                }
-                for (aux_output_idx, channel_count) in layout.aux_output_ports.iter().enumerate() {
-                    if unsafe {
-                        (*outputs.add(aux_output_idx + aux_output_start_idx)).count_ones()
-                            != channel_count.get()
-                    } {
-                        return false;
-                    }
-                }
-
-                true
-            })
-            .copied();
-
-        match matching_layout {
-            Some(layout) => {
-                // This layout is used from hereon onwards, at least until this function is called
-                // again
-                self.inner.current_audio_io_layout.store(layout);
-
-                kResultOk
-            }
-            None => kResultFalse,
+        // Ressort patch: the host arranges the union of the layouts' busses (see `busses`). An
+        // empty arrangement means the bus is absent; the arrangement is accepted when some
+        // layout has exactly the non-empty busses with these channel counts. The layout in use
+        // also depends on which busses the host activates.
+        // NOTE: Only the channel counts are compared, not the speaker positions.
+        let counts = |arrangements: *mut SpeakerArrangement, n: int32| -> Vec<u32> {
+            (0..n as usize)
+                .map(|i| unsafe { (*arrangements.add(i)).count_ones() })
+                .collect()
+        };
+        let input_counts = counts(inputs, num_ins);
+        let output_counts = counts(outputs, num_outs);
+        if busses::matching(P::AUDIO_IO_LAYOUTS, &input_counts, &output_counts).is_none() {
+            return kResultFalse;
         }
+
+        let mut host = self.inner.host_busses.lock();
+        host.input_channels = input_counts;
+        host.output_channels = output_counts;
+        if !self.inner.is_processing.load(Ordering::SeqCst) {
+            let layout = host.layout(P::AUDIO_IO_LAYOUTS).or_else(|| {
+                busses::matching(P::AUDIO_IO_LAYOUTS, &host.input_channels, &host.output_channels)
+            });
+            if let Some(layout) = layout {
+                self.inner.current_audio_io_layout.store(layout);
+            }
+        }
+
+        kResultOk
     }
 
     unsafe fn getBusArrangement(
@@ -940,31 +819,29 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
             }
         };
 
-        let current_audio_io_layout = self.inner.current_audio_io_layout.load();
-        let num_channels = if dir == K_BUS_DIRECTION_INPUT {
-            let has_main_input = current_audio_io_layout.main_input_channels.is_some();
-            let aux_input_start_idx = if has_main_input { 1 } else { 0 };
-            let aux_input_idx = (index - aux_input_start_idx).max(0) as usize;
-            if index == 0 && has_main_input {
-                current_audio_io_layout.main_input_channels.unwrap().get()
-            } else if aux_input_idx < current_audio_io_layout.aux_input_ports.len() {
-                current_audio_io_layout.aux_input_ports[aux_input_idx].get()
-            } else {
-                return kInvalidArgument;
-            }
+        // Ressort patch: busses of the union (see `busses`). A bus the current layout does not
+        // use reports the arrangement it would have.
+        let input = if dir == K_BUS_DIRECTION_INPUT {
+            true
         } else if dir == K_BUS_DIRECTION_OUTPUT {
-            let has_main_output = current_audio_io_layout.main_output_channels.is_some();
-            let aux_output_start_idx = if has_main_output { 1 } else { 0 };
-            let aux_output_idx = (index - aux_output_start_idx).max(0) as usize;
-            if index == 0 && has_main_output {
-                current_audio_io_layout.main_output_channels.unwrap().get()
-            } else if aux_output_idx < current_audio_io_layout.aux_output_ports.len() {
-                current_audio_io_layout.aux_output_ports[aux_output_idx].get()
-            } else {
-                return kInvalidArgument;
-            }
+            false
         } else {
             return kInvalidArgument;
+        };
+        if index < 0 || index as usize >= busses::count(P::AUDIO_IO_LAYOUTS, input) {
+            return kInvalidArgument;
+        }
+        let current_audio_io_layout = self.inner.current_audio_io_layout.load();
+        let num_channels = match busses::channels_in(
+            P::AUDIO_IO_LAYOUTS,
+            &current_audio_io_layout,
+            input,
+            index as usize,
+        ) {
+            0 => busses::describe(P::AUDIO_IO_LAYOUTS, input, index as usize)
+                .map(|b| b.channels)
+                .unwrap_or(0),
+            n => n,
         };
         let channel_map = channel_count_to_map(num_channels);
 
@@ -1087,8 +964,9 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
             let current_audio_io_layout = self.inner.current_audio_io_layout.load();
             let has_main_input = current_audio_io_layout.main_input_channels.is_some();
             let has_main_output = current_audio_io_layout.main_output_channels.is_some();
-            let aux_input_start_idx = if has_main_input { 1 } else { 0 };
-            let aux_output_start_idx = if has_main_output { 1 } else { 0 };
+            // Ressort patch: the host's busses are the union of the layouts (see `busses`).
+            let aux_input_start_idx = busses::aux_start(P::AUDIO_IO_LAYOUTS, true);
+            let aux_output_start_idx = busses::aux_start(P::AUDIO_IO_LAYOUTS, false);
 
             // NOTE: VST3 hosts may trigger a 'parameter flush' by calling the process function for
             //       0 input samples. If this is the case then we'll only handle events and skip all
@@ -1425,11 +1303,22 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
                     // The buffer manager preallocated buffer slices for all the IO and storage for
                     // any axuiliary inputs.
                     let mut buffer_manager = self.inner.buffer_manager.borrow_mut();
+                    // Ressort patch: a bus is used only when every channel has a buffer. JUCE
+                    // hosts pass null channel pointers for a bus whose channels their own
+                    // buffer does not have (DawDreamer with every bus enabled and a two-channel
+                    // graph); such a bus counts as missing (silent input, no output).
+                    let usable = |bus: *const vst3::Steinberg::Vst::AudioBusBuffers| -> bool {
+                        let bus = unsafe { &*bus };
+                        let ptrs = unsafe { bus.__field0.channelBuffers32 };
+                        !ptrs.is_null()
+                            && (0..bus.numChannels.max(0) as usize)
+                                .all(|c| unsafe { !(*ptrs.add(c)).is_null() })
+                    };
                     let buffers = unsafe {
                         buffer_manager.create_buffers(block_start, block_len, |buffer_source| {
                             if data.numOutputs > 0
                                 && !data.outputs.is_null()
-                                && !(*data.outputs).__field0.channelBuffers32.is_null()
+                                && usable(data.outputs)
                                 && has_main_output
                             {
                                 let audio_output = &*data.outputs;
@@ -1443,7 +1332,7 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
 
                             if data.numInputs > 0
                                 && !data.inputs.is_null()
-                                && !(*data.inputs).__field0.channelBuffers32.is_null()
+                                && usable(data.inputs)
                                 && has_main_input
                             {
                                 let audio_input = &*data.inputs;
@@ -1468,6 +1357,9 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
                                         break;
                                     }
 
+                                    if !usable(data.inputs.add(aux_input_idx)) {
+                                        continue;
+                                    }
                                     let audio_input = &*data.inputs.add(aux_input_idx);
                                     match NonNull::new(audio_input.__field0.channelBuffers32) {
                                         Some(ptrs) => {
@@ -1492,6 +1384,9 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
                                         break;
                                     }
 
+                                    if !usable(data.outputs.add(aux_output_idx)) {
+                                        continue;
+                                    }
                                     let audio_output = &*data.outputs.add(aux_output_idx);
                                     match NonNull::new(audio_output.__field0.channelBuffers32) {
                                         Some(ptrs) => {
