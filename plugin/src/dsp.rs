@@ -164,7 +164,16 @@ mod tests {
 
     #[test]
     fn output_is_never_subnormal() {
-        for x in [1e-40, -1.27e-40, 1e-35, -1e-31, 1e-300, f64::MIN_POSITIVE / 2.0, 0.0, -0.0] {
+        for x in [
+            1e-40,
+            -1.27e-40,
+            1e-35,
+            -1e-31,
+            1e-300,
+            f64::MIN_POSITIVE / 2.0,
+            0.0,
+            -0.0,
+        ] {
             let y = output_sample(x);
             assert!(!y.is_subnormal(), "{x} -> {y:e}");
             assert_eq!(y, 0.0, "{x}");

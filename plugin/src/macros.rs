@@ -174,7 +174,10 @@ mod tests {
             }
             assert_eq!(b.normalized_of(b.default), 0.5);
             assert_eq!(b.normalized_of(f64::INFINITY), 1.0);
-            assert_eq!(b.normalized_of(b.min - 1.0).min(0.5), b.normalized_of(b.min - 1.0));
+            // Below the range: the bottom of the slot, or its centre when the range starts at
+            // the declared value.
+            let bottom = if b.min < b.default { 0.0 } else { 0.5 };
+            assert_eq!(b.normalized_of(b.min - 1.0), bottom);
         }
     }
 }

@@ -9,18 +9,18 @@
 //! diagnostics are kept in [`ModelStore::status`] for the editor.
 
 use crate::envelope::{envelope, raw_envelope, worst_load};
-use crate::host::HostSettings;
 pub use crate::envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
+use crate::host::HostSettings;
 use crate::macros::macro_bindings;
 pub use crate::macros::MacroBinding;
-use crate::param_text;
 use crate::motion::{motion_channel, MotionReader, MotionWriter};
+use crate::param_text;
 use crate::runtime::RuntimeStatus;
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::params::persist::PersistentField;
 use ressort_engine::{
-    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, RouteSource,
-    SampleRateMode, REFERENCE_SAMPLE_RATE_HZ,
+    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, RouteSource, SampleRateMode,
+    REFERENCE_SAMPLE_RATE_HZ,
 };
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -52,7 +52,8 @@ pub fn format_factor(f: f32) -> String {
 /// clamped to ±`max_octaves`. Zero, negative and non-numbers give `None`.
 pub fn parse_factor(text: &str, max_octaves: f32) -> Option<f32> {
     let t = clean(text);
-    let t = t.trim_matches(|c: char| c == '×' || c == 'x' || c == 'X' || c == '*' || c.is_whitespace());
+    let t =
+        t.trim_matches(|c: char| c == '×' || c == 'x' || c == 'X' || c == '*' || c.is_whitespace());
     let f = match t.split_once('/') {
         Some((a, b)) => number(a)? / number(b)?,
         None => number(t)?,

@@ -33,11 +33,15 @@ fn assert_every_text_round_trips(plugin: &mut TestPlugin) -> usize {
             let text = plugin
                 .param_text(p.id, value)
                 .unwrap_or_else(|| panic!("{}: no text for {value}", p.name));
-            let back = plugin
-                .param_value_of_text(p.id, &text)
-                .unwrap_or_else(|| panic!("{}: '{text}' (from {value}) does not read back", p.name));
+            let back = plugin.param_value_of_text(p.id, &text).unwrap_or_else(|| {
+                panic!("{}: '{text}' (from {value}) does not read back", p.name)
+            });
             let again = plugin.param_text(p.id, back).unwrap();
-            assert_eq!(again, text, "{}: {value} -> '{text}' -> {back} -> '{again}'", p.name);
+            assert_eq!(
+                again, text,
+                "{}: {value} -> '{text}' -> {back} -> '{again}'",
+                p.name
+            );
             let last = plugin.param_value_of_text(p.id, &again).unwrap();
             assert_eq!(last, back, "{}: '{again}' reads {last}, not {back}", p.name);
             checked += 1;
@@ -71,7 +75,10 @@ fn texts_put_the_number_first_and_read_what_people_type() {
             "Stiffness '{typed}' reads {v:?}"
         );
     }
-    assert_eq!(plugin.param_value_of_text(stiffness, "1/4"), Some((-2.0 + 4.0) / 8.0));
+    assert_eq!(
+        plugin.param_value_of_text(stiffness, "1/4"),
+        Some((-2.0 + 4.0) / 8.0)
+    );
     assert_eq!(plugin.param_value_of_text(stiffness, "-4"), None);
 
     let gain = id(&mut plugin, "Output Gain");
@@ -86,7 +93,10 @@ fn texts_put_the_number_first_and_read_what_people_type() {
     assert_eq!(plugin.param_text(gain, minus6).as_deref(), Some("-6.0 dB"));
 
     let tune = id(&mut plugin, "Tune");
-    assert_eq!(plugin.param_text(tune, (3.0 + 24.0) / 48.0).as_deref(), Some("+3.00 st"));
+    assert_eq!(
+        plugin.param_text(tune, (3.0 + 24.0) / 48.0).as_deref(),
+        Some("+3.00 st")
+    );
     assert_eq!(plugin.param_text(tune, 0.5).as_deref(), Some("0.00 st"));
     let v = plugin.param_value_of_text(tune, "-12 st").unwrap();
     assert!((v - 0.25).abs() < 1e-6, "Tune '-12 st' reads {v}");
@@ -97,11 +107,20 @@ fn texts_put_the_number_first_and_read_what_people_type() {
     assert_eq!(plugin.param_value_of_text(guard, "Clear"), Some(0.0));
 
     let macro1 = id(&mut plugin, "Macro 1");
-    assert_eq!(plugin.param_text(macro1, 0.5).as_deref(), Some("K = 0.0800"));
+    assert_eq!(
+        plugin.param_text(macro1, 0.5).as_deref(),
+        Some("K = 0.0800")
+    );
     assert_eq!(plugin.param_value_of_text(macro1, "K = 0.0800"), Some(0.5));
     assert_eq!(plugin.param_value_of_text(macro1, "0.08"), Some(0.5));
     assert_eq!(plugin.param_value_of_text(macro1, "Z = 0.08"), None);
     let macro3 = id(&mut plugin, "Macro 3");
-    assert_eq!(plugin.param_text(macro3, 0.25).as_deref(), Some("unbound (25 %)"));
-    assert_eq!(plugin.param_value_of_text(macro3, "unbound (25 %)"), Some(0.25));
+    assert_eq!(
+        plugin.param_text(macro3, 0.25).as_deref(),
+        Some("unbound (25 %)")
+    );
+    assert_eq!(
+        plugin.param_value_of_text(macro3, "unbound (25 %)"),
+        Some(0.25)
+    );
 }
