@@ -8,7 +8,7 @@
 //! old one back to be freed off the audio thread. Host gains (Stiffness, Damping, Tune, MIDI
 //! pitch) are clamped to what the model's stability analysis allows.
 
-use model::{InputRole, ModelStore, Prepared, CHUNK, NUM_MACROS};
+use model::{ModelStore, Prepared, CHUNK, NUM_MACROS};
 use nice_plug::prelude::*;
 use ressort_engine::ScaleClass;
 use std::num::NonZeroU32;
@@ -32,7 +32,6 @@ pub mod runtime;
 use dsp::{db_to_gain, output_sample, soft_ceiling, tuning_gain, ChunkSmoother, DcBlocker};
 use params::RessortParams;
 use report::{HostLink, MainThreadTask};
-use ressort_engine::RouteSource;
 use runtime::RuntimeStatus;
 
 /// Length of the crossfade from a replaced model to the new one.
@@ -422,36 +421,6 @@ impl Ressort {
         retuned
     }
 
-    /// Fills a model's planar input scratch for one chunk from the host channels.
-    fn fill_inputs(
-        model: &mut Prepared,
-        host_in: &[[f64; CHUNK]; 4],
-        order: &[RouteSource],
-        len: usize,
-        force: f64,
-        position: f64,
-    ) {
-        for (k, role) in model.roles.iter().enumerate() {
-            let source = model.routing[k].or_else(|| order.get(k).copied());
-            let gain = match role {
-                InputRole::Force => force * model.force_scale,
-                InputRole::Position => position,
-                InputRole::AudioParam => 1.0,
-                InputRole::Unused => 0.0,
-            };
-            let rest = model.rest[k];
-            let dst = &mut model.inputs[k * len..(k + 1) * len];
-            match source.and_then(host::channel) {
-                Some(c) if gain != 0.0 => {
-                    for (d, s) in dst.iter_mut().zip(&host_in[c][..len]) {
-                        *d = rest + s * gain;
-                    }
-                }
-                _ => dst.fill(rest),
-            }
-        }
-    }
-
     /// Puts the model back at rest and fades the output back in.
     fn restart_model(&mut self) {
         if let Some(model) = self.current.as_mut() {
@@ -703,7 +672,7 @@ impl Plugin for Ressort {
 
             let (force, position) = (self.force_gain.value, self.position_gain.value);
             if let Some(model) = self.current.as_mut() {
-                Self::fill_inputs(model, &self.host_in, order, len, force, position);
+                model.fill_inputs(&self.host_in, order, len, force, position);
             }
             if self.handle_events(context, pos, len) {
                 self.apply_controls(None);

@@ -342,6 +342,41 @@ pub fn peak_frequency(signal: &[f64], sample_rate: f64) -> Option<f64> {
 }
 
 impl Prepared {
+    /// Fills the planar input scratch for one chunk of `len` samples from the host channels
+    /// (`host_in`: main left, main right, sidechain left, sidechain right; see
+    /// [`crate::host::channel`]). Each model input takes the channel its `~route` names, else
+    /// the next of `order`; a position input receives its rest + signal × `position`, a force
+    /// input signal × `force` × [`Prepared::force_scale`], an audio-rate parameter the raw
+    /// signal. An unfed input holds its rest.
+    pub fn fill_inputs(
+        &mut self,
+        host_in: &[[f64; CHUNK]; 4],
+        order: &[RouteSource],
+        len: usize,
+        force: f64,
+        position: f64,
+    ) {
+        for (k, role) in self.roles.iter().enumerate() {
+            let source = self.routing[k].or_else(|| order.get(k).copied());
+            let gain = match role {
+                InputRole::Force => force * self.force_scale,
+                InputRole::Position => position,
+                InputRole::AudioParam => 1.0,
+                InputRole::Unused => 0.0,
+            };
+            let rest = self.rest[k];
+            let dst = &mut self.inputs[k * len..(k + 1) * len];
+            match source.and_then(crate::host::channel) {
+                Some(c) if gain != 0.0 => {
+                    for (d, s) in dst.iter_mut().zip(&host_in[c][..len]) {
+                        *d = rest + s * gain;
+                    }
+                }
+                _ => dst.fill(rest),
+            }
+        }
+    }
+
     /// The editor's description of this model.
     pub fn summary(&mut self) -> ModelSummary {
         let info = self.engine.info();
