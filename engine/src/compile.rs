@@ -585,7 +585,17 @@ impl<'a> Compiler<'a> {
                     }
                     (value, None)
                 }
-                ParamKind::Audio { input } => {
+                ParamKind::Audio { input, default } => {
+                    if !default.is_finite() {
+                        self.errors.push(CompileError {
+                            kind: CompileErrorKind::InvalidValue {
+                                what: "an audio-rate parameter's default must be finite",
+                                value: default,
+                            },
+                            label: p.name.clone(),
+                            span: p.span,
+                        });
+                    }
                     if input == 0 {
                         self.errors.push(CompileError {
                             kind: CompileErrorKind::InvalidChannel,
@@ -598,7 +608,7 @@ impl<'a> Compiler<'a> {
                             index: id as u32,
                         });
                     }
-                    (0.0, Some(input))
+                    (default, Some(input))
                 }
             };
             params.push(if value.is_finite() { value } else { 0.0 });
@@ -1030,6 +1040,11 @@ impl<'a> Compiler<'a> {
             outputs,
             motion,
         };
+        // Parameters start at their declared values: an audio-rate one at its default.
+        let audio_defaults = audio_params
+            .iter()
+            .map(|r| params[r.index as usize])
+            .collect();
         let mut engine = Engine {
             info,
             points: Points {
@@ -1044,6 +1059,7 @@ impl<'a> Compiler<'a> {
             interactions,
             avatars,
             audio_params,
+            audio_defaults,
             force_inputs,
             pos_outputs,
             frc_outputs,

@@ -595,6 +595,8 @@ pub struct Engine {
     pub(crate) avatars: Vec<Route>,
     /// Audio-rate parameters: input channel → parameter slot (stage 1 b).
     pub(crate) audio_params: Vec<Route>,
+    /// The declared default of each entry of `audio_params`, added to its input.
+    pub(crate) audio_defaults: Vec<f64>,
     /// Force inputs: input channel → point (stage 4).
     pub(crate) force_inputs: Vec<Route>,
     /// `posOutput`: output channel ← point.
@@ -697,7 +699,8 @@ impl Engine {
             .map(|i| ParamId(i as u32))
     }
 
-    /// The current value of a parameter (an audio-rate one holds its last input sample).
+    /// The current value of a parameter (an audio-rate one holds its default plus its last
+    /// input sample, and its default before the first sample).
     pub fn param(&self, id: ParamId) -> Option<f64> {
         self.params.get(id.0 as usize).copied()
     }
@@ -1016,8 +1019,10 @@ impl Engine {
         }
         // Stage 1 b: audio-rate parameters, and the arguments and coefficients that use them.
         if !self.audio_params.is_empty() {
-            for r in &self.audio_params {
-                self.params[r.index as usize] = input(r.channel);
+            // Default + signal (`ParamKind::Audio`): spec §1.5 stage 1 b with the default of
+            // this project's `audioParam @inN default`; 0 gives the spec's in_N(n) exactly.
+            for (r, d) in self.audio_params.iter().zip(&self.audio_defaults) {
+                self.params[r.index as usize] = d + input(r.channel);
             }
             self.refresh_audio_args(scale);
             for &i in &self.audio_masses {

@@ -42,7 +42,8 @@ pub struct OwnerInfo {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParamInfo {
     pub name: String,
-    /// The declared value of a control-rate parameter (0 for audio-rate ones).
+    /// The declared value of a control-rate parameter, or the default of an audio-rate one
+    /// (its value while its input is silent).
     pub default: f64,
     /// The 1-based input channel of an audio-rate parameter.
     pub audio_input: Option<u32>,

@@ -60,8 +60,11 @@ pub struct ParamDecl {
 pub enum ParamKind {
     /// `@name param value`: changed by the host between blocks.
     Control { value: f64 },
-    /// `@name audioParam @inN`: takes input channel `input` (1-based) at every sample.
-    Audio { input: u32 },
+    /// `@name audioParam @inN [default]`: at every sample (spec §1.5 stage 1 b, §3.8) its
+    /// value is `default` + input channel `input` (1-based). An unfed or silent input gives
+    /// the default; a connected one modulates around it. The default is a project extension
+    /// (0 when omitted, so a MIMS4Max script keeps its meaning: the value is the input).
+    Audio { input: u32, default: f64 },
 }
 
 /// A position or velocity argument (spec §3.7): a scalar z, or an `[x y z]` vector whose x and
@@ -563,11 +566,16 @@ impl ModelBuilder {
         self
     }
 
-    /// `@name audioParam @inN`.
+    /// `@name audioParam @inN` (default 0).
     pub fn audio_param(&mut self, name: &str, input: u32) -> &mut Self {
+        self.audio_param_with_default(name, input, 0.0)
+    }
+
+    /// `@name audioParam @inN default`: default + input N.
+    pub fn audio_param_with_default(&mut self, name: &str, input: u32, default: f64) -> &mut Self {
         self.spec.params.push(ParamDecl {
             name: name.to_string(),
-            kind: ParamKind::Audio { input },
+            kind: ParamKind::Audio { input, default },
             span: Span::default(),
         });
         self

@@ -188,6 +188,45 @@ fn audio_rate_parameters_follow_their_input_every_sample() {
     }
 }
 
+/// `@K audioParam @in2 0.01`: K is 0.01 + in2 at every sample, so a silent input gives the
+/// default and a connected one modulates around it; the value is the default before the first
+/// sample too (stability analysis, `param`).
+#[test]
+fn audio_rate_parameters_are_their_default_plus_their_input() {
+    let spec = {
+        let mut b = ModelBuilder::new();
+        b.raw();
+        b.audio_param_with_default("K", 2, 0.01);
+        b.osc("o", 1.0, "K", 0.0, 1.0, 0.0);
+        b.pos_output(1, Endpoint::label("o"));
+        b.build()
+    };
+    let mut e = engine(&spec, 44_100.0);
+    let id = e.param_id("K").unwrap();
+    assert_eq!(e.param(id), Some(0.01));
+    assert_eq!(e.info().params[0].default, 0.01);
+    let frames = 100;
+    // Silent for 50 samples, then +0.03: K = 0.01, then 0.04.
+    let k: Vec<f64> = (0..frames)
+        .map(|n| if n < 50 { 0.0 } else { 0.03 })
+        .collect();
+    let out = render(&mut e, frames, 32, &[vec![0.0; frames], k]);
+    assert!((e.param(id).unwrap() - 0.04).abs() < 1e-15);
+    let (mut x, mut xp) = (1.0f64, 1.0f64);
+    for n in 0..frames {
+        let kk = if n < 50 { 0.01 } else { 0.01 + 0.03 };
+        let next = (2.0 - kk) * x - xp;
+        xp = x;
+        x = next;
+        assert!((out[0][n] - x).abs() < 1e-13, "sample {n}");
+    }
+    // The same model from text, with the input left out of the call entirely.
+    let parsed = ressort_engine::parse(
+        "~samplerate raw\n@K audioParam @in2 0.01\n@o osc 1 K 0 1 0\n@out1 posOutput @o\n",
+    );
+    assert_eq!(parsed.spec.as_ref(), Some(&spec));
+}
+
 #[test]
 fn class_gain_scales_every_stiffness() {
     // A stiffness gain of 4 on a string doubles its pitch (K ∝ f² for low modes).

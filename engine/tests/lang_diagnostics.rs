@@ -884,6 +884,36 @@ fn audio_params() {
     let spec = p.spec.unwrap();
     assert_eq!(
         spec.params[0].kind,
-        ressort_engine::ParamKind::Audio { input: 2 }
+        ressort_engine::ParamKind::Audio {
+            input: 2,
+            default: 0.0
+        }
     );
+    let p = parse("@lX audioParam @in2 0.3\n@lY audioParam @in3 -1e-3\n");
+    assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
+    let spec = p.spec.unwrap();
+    assert_eq!(
+        spec.params[1].kind,
+        ressort_engine::ParamKind::Audio {
+            input: 3,
+            default: -1e-3
+        }
+    );
+}
+
+/// A bad `audioParam` default is reported at its column; a default written before the input
+/// gets the right order in the message.
+#[test]
+fn audio_param_defaults() {
+    after_prelude("@a audioParam @in2 x", C::InvalidNumber, 20);
+    after_prelude("@a audioParam @in2 [0.1+0.2]", C::InvalidNumber, 20);
+    after_prelude("@a audioParam @in2 K", C::InvalidNumber, 20);
+    after_prelude("@a audioParam @in2 1e999", C::NonFiniteNumber, 20);
+    after_prelude("@a audioParam @in2 0.3 0.4", C::WrongArgumentCount, 24);
+    let d = after_prelude("@a audioParam 0.3 @in2", C::BadChannelLabel, 15);
+    assert!(d.message.contains("write `@in2 0.3`"), "{}", d.message);
+    // A bad input and a bad default are both reported.
+    let p = parse(&with_prelude("@a audioParam @in0 y"));
+    find(&p, C::BadChannelLabel, 5, 15);
+    find(&p, C::InvalidNumber, 5, 20);
 }

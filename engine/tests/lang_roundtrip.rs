@@ -187,7 +187,8 @@ fn spec() -> impl Strategy<Value = ModelSpec> {
             proptest::collection::vec(
                 prop_oneof![
                     num().prop_map(|value| ParamKind::Control { value }),
-                    (1u32..9).prop_map(|input| ParamKind::Audio { input }),
+                    (1u32..9, prop_oneof![Just(0.0), num()])
+                        .prop_map(|(input, default)| ParamKind::Audio { input, default }),
                 ],
                 n,
             ),
@@ -529,4 +530,41 @@ fn host_directives_round_trip() {
         .expect("printed text parses");
     assert_eq!(first.host, second.host, "{printed}");
     assert_eq!(first, second);
+}
+
+/// An `audioParam` default survives printing; a zero default prints as the MIMS4Max form.
+#[test]
+fn audio_param_defaults_round_trip() {
+    let text = "@lX audioParam @in3 0.3\n@lY audioParam @in4 -2.5e-3\n@cX audioParam @in5 0\n\
+                @cY audioParam @in6\n";
+    let first = ressort_engine::parse(text).spec.expect("parses");
+    let defaults: Vec<ParamKind> = first.params.iter().map(|p| p.kind.clone()).collect();
+    assert_eq!(
+        defaults,
+        vec![
+            ParamKind::Audio {
+                input: 3,
+                default: 0.3
+            },
+            ParamKind::Audio {
+                input: 4,
+                default: -2.5e-3
+            },
+            ParamKind::Audio {
+                input: 5,
+                default: 0.0
+            },
+            ParamKind::Audio {
+                input: 6,
+                default: 0.0
+            },
+        ]
+    );
+    let printed = print(&first);
+    assert_eq!(
+        printed,
+        "@lX audioParam @in3 0.3\n@lY audioParam @in4 -0.0025\n@cX audioParam @in5\n\
+         @cY audioParam @in6\n"
+    );
+    assert_eq!(ressort_engine::parse(&printed).spec, Some(first));
 }

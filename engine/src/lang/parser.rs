@@ -15,12 +15,14 @@ use super::generate::{self, GenRequest, Read, MAX_GENERATED_ELEMENTS};
 use super::legacy;
 use super::lexer::{is_blank, split_items, split_lines, tokenize, TokKind, Token};
 use super::Parsed;
-use crate::expr::{Expr, Func};
+use crate::expr::Expr;
 use crate::spec::{
-    Element, ElementKind, Endpoint, Law, MacroKind, MacroRange, MacroSpec, ModelSpec, ParamDecl,
-    ParamKind, Route, RouteSource, SampleRateMode, Span, Vector,
+    Element, ElementKind, Endpoint, Law, MacroKind, MacroRange, MacroSpec, ModelSpec, Route,
+    RouteSource, SampleRateMode, Span, Vector,
 };
 use std::collections::HashMap;
+
+mod params;
 
 /// The most nodes one macro may have: 1 048 576 (the compiler's point limit).
 pub const MAX_MACRO_NODES: u64 = 1 << 20;
@@ -123,7 +125,7 @@ fn arity(shape: Shape) -> (usize, usize, &'static str) {
         Shape::PosInput => (1, 1, "pos"),
         Shape::FrcInput | Shape::PosOutput | Shape::FrcOutput => (1, 1, "target"),
         Shape::Param => (1, 1, "value"),
-        Shape::AudioParam => (1, 1, "@inN"),
+        Shape::AudioParam => (1, 2, "@inN {default}"),
     }
 }
 
@@ -1590,91 +1592,6 @@ impl Builder<'_> {
             );
         }
         value
-    }
-
-    fn param(
-        &mut self,
-        shape: Shape,
-        label: &str,
-        first: &Token,
-        args: &[Token],
-        at: At<'_>,
-        span: Span,
-    ) -> Option<ParamDecl> {
-        let name_ok = is_identifier(label) && Func::from_name(label).is_none();
-        if !name_ok {
-            self.diags.push(
-                at.diag(
-                    DiagnosticCode::BadLabel,
-                    first.col,
-                    format!(
-                        "parameter name `{label}` must be an identifier ([A-Za-z_][A-Za-z0-9_]*) \
-                         that is not a function name"
-                    ),
-                )
-                .with_found(label.to_string()),
-            );
-        }
-        let v = args.first()?;
-        let kind = if shape == Shape::Param {
-            let r = if v.kind == TokKind::Bracket {
-                Err(NumberError::Invalid)
-            } else {
-                parse_number_literal(&v.text)
-            };
-            match r {
-                Ok(value) => Some(ParamKind::Control { value }),
-                Err(e) => {
-                    let (code, message) = match e {
-                        NumberError::Invalid => (
-                            DiagnosticCode::InvalidNumber,
-                            format!(
-                                "a param value is a numeric literal with an optional sign, \
-                                 found `{}`",
-                                v.source()
-                            ),
-                        ),
-                        NumberError::NonFinite => (
-                            DiagnosticCode::NonFiniteNumber,
-                            format!("non-finite number `{}`", v.source()),
-                        ),
-                    };
-                    self.diags.push(
-                        at.diag(code, v.col, message)
-                            .with_expected("a number such as `0.5` or `-1e-3`")
-                            .with_found(v.source()),
-                    );
-                    None
-                }
-            }
-        } else {
-            let text = v.string();
-            let input = match text.strip_prefix('@') {
-                Some(l) if v.kind == TokKind::Bare => self.channel(l, "in", v, at),
-                _ => {
-                    self.diags.push(
-                        at.diag(
-                            DiagnosticCode::BadChannelLabel,
-                            v.col,
-                            format!(
-                                "`audioParam` takes an input label `@inN`, found `{}`",
-                                v.source()
-                            ),
-                        )
-                        .with_expected("@inN")
-                        .with_found(v.source()),
-                    );
-                    None
-                }
-            };
-            input.map(|input| ParamKind::Audio { input })
-        };
-        let kind = kind?;
-        name_ok.then(|| ParamDecl {
-            name: label.to_string(),
-            kind,
-            span,
-        })
     }
 
     /// Builds an element from arguments of an accepted count. `points` are the legacy bare

@@ -378,8 +378,17 @@ pub fn print(spec: &ModelSpec) -> String {
             ParamKind::Control { value } => {
                 let _ = writeln!(out, "@{} param {}", p.name, format_number(value));
             }
-            ParamKind::Audio { input } => {
+            // A zero default is left out: the MIMS4Max form, which means the same.
+            ParamKind::Audio { input, default } if default == 0.0 => {
                 let _ = writeln!(out, "@{} audioParam @in{input}", p.name);
+            }
+            ParamKind::Audio { input, default } => {
+                let _ = writeln!(
+                    out,
+                    "@{} audioParam @in{input} {}",
+                    p.name,
+                    format_number(default)
+                );
             }
         }
     }
