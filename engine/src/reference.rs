@@ -184,7 +184,10 @@ pub fn fretted_string() -> ModelSpec {
 
 /// Chladni Huge Model (spec §7.4): `closedMesh 150 150`, the gallery hammer block at
 /// (eX, eY) = (0.9, 0.8), a moving contact at audio-rate (cX, cY) pressed by the avatar in2,
-/// and a listening point at audio-rate (lX, lY). 22 503 points, 44 703 interactions.
+/// and a listening point at audio-rate (lX, lY). 22 503 points, 44 703 interactions. The
+/// audio-rate coordinates have defaults, which the specification does not give, so that the
+/// model sounds with their inputs silent: it listens at (0.3, 0.6) and the contact sits at
+/// (0.7, 0.3), away from the pinned border and the hammer.
 pub fn chladni_150() -> ModelSpec {
     let mut b = ModelBuilder::new();
     b.param("meshK", 0.01)
@@ -193,10 +196,10 @@ pub fn chladni_150() -> ModelSpec {
         .param("eX", 0.9)
         .param("eY", 0.8)
         .param("contactStiffness", 0.1)
-        .audio_param("lX", 3)
-        .audio_param("lY", 4)
-        .audio_param("cX", 5)
-        .audio_param("cY", 6);
+        .audio_param_with_default("lX", 3, 0.3)
+        .audio_param_with_default("lY", 4, 0.6)
+        .audio_param_with_default("cX", 5, 0.7)
+        .audio_param_with_default("cY", 6, 0.3);
     b.macro_spec(
         "mesh",
         MacroSpec {

@@ -104,17 +104,18 @@ fn every_preset_has_the_counts_of_the_specification() {
     }
 }
 
-/// A parameter's declared value; audio-rate parameters read as 0.5 (the test feeds them 0.5).
+/// A parameter's declared value; audio-rate parameters read as their default, their value
+/// with a silent input (the test leaves their inputs unfed, as the plugin and `ressort render`
+/// do).
 fn lookup(spec: &ModelSpec) -> impl Fn(&str) -> Option<f64> + '_ {
     move |name| {
         spec.param(name).map(|p| match p.kind {
             ParamKind::Control { value } => value,
-            ParamKind::Audio { .. } => AUDIO_PARAM_VALUE,
+            ParamKind::Audio { default, .. } => default,
         })
     }
 }
 
-const AUDIO_PARAM_VALUE: f64 = 0.5;
 /// Strong enough for every hanging hammer: a suspension of damping Z stops a kick of I after
 /// |I|/Z units, and the hammer oscillators hang 1 unit above with Z = 0.05.
 const FORCE_IMPULSE: f64 = -0.1;
@@ -159,8 +160,9 @@ fn role(spec: &ModelSpec, avatar: &str) -> Role {
 /// force impulse on force inputs; bows moved from their start at half their Vscale (inside the
 /// slip band Vscale/3…Vscale, where the bow self-oscillates); plectra swept smoothly through
 /// the string (from p to −p, or 4·Pscale down when they start on it); every other avatar held
-/// at its declared position (an input at 0 would make it jump there in one sample); audio-rate
-/// parameters at 0.5.
+/// at its declared position (an input at 0 would make it jump there in one sample); the inputs
+/// of audio-rate parameters unfed (silent), as in the plugin's instrument layout, which feeds
+/// only `@in1` and `@in2`, and in `ressort render` without `--input`.
 fn excitation(spec: &ModelSpec, inputs: &[Vec<InputUse>], sr: f64, frames: usize) -> Vec<Vec<f64>> {
     let value = lookup(spec);
     let z_scale = REFERENCE_SAMPLE_RATE_HZ / sr;
@@ -209,7 +211,7 @@ fn excitation(spec: &ModelSpec, inputs: &[Vec<InputUse>], sr: f64, frames: usize
                     Role::Hold => vec![start; frames],
                 }
             }
-            Some(InputUse::Param(_)) => vec![AUDIO_PARAM_VALUE; frames],
+            Some(InputUse::Param(_)) => vec![0.0; frames],
             None => vec![0.0; frames],
         })
         .collect()
@@ -219,10 +221,24 @@ fn excitation(spec: &ModelSpec, inputs: &[Vec<InputUse>], sr: f64, frames: usize
 /// avatar). A disconnected output or an excitation that never reaches the structure gives 0.
 const SILENCE: f64 = 1e-7;
 
+/// The smallest peak excursion of `@out1` from its value at rest, relative to the strike
+/// |FORCE_IMPULSE|, for a preset struck through a force input as its header says: a hundred
+/// times [`SILENCE`] (a listening point or strike pinned at a corner gives exactly 0) and
+/// about 5 times below the quietest struck preset, NoFx Drone, whose listening chain only a
+/// 1e-5 damper couples to the struck one (4.7e-5); the others move by 0.04 or more.
+const FIRST_OUTPUT_MOVES: f64 = 1e-4;
+
+/// The same for presets played only by position gestures (bows, plectra) or by themselves: the
+/// bowed ones with their published bow friction are quiet by design (their headers say to add
+/// gain; Resonant Strings gives a few 1e-6), so the bar is ten times [`SILENCE`].
+const FIRST_OUTPUT_MOVES_UNSTRUCK: f64 = 1e-6;
+
 #[test]
 fn every_preset_is_stable_and_sounds() {
     const SR: f64 = 48_000.0;
     const FRAMES: usize = 48_000;
+    // Silent outputs are collected, so that one run names every preset that does not play.
+    let mut silent = Vec::new();
     for (name, text) in presets() {
         let parsed = parse(&text);
         let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
@@ -269,20 +285,54 @@ fn every_preset_is_stable_and_sounds() {
             let peak = ch.iter().fold(0.0f64, |m, v| m.max((v - ch[0]).abs()));
             let mean = ch.iter().sum::<f64>() / ch.len() as f64;
             let rms = (ch.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / ch.len() as f64).sqrt();
-            assert!(
-                peak > SILENCE,
-                "{name}: out{} is silent (peak excursion {peak:e})",
-                c + 1
-            );
+            if !(peak > SILENCE) {
+                silent.push(format!(
+                    "{name}: out{} is silent (peak excursion {peak:e})",
+                    c + 1
+                ));
+            }
             if peak > loudest.0 {
                 loudest = (peak, rms);
             }
         }
+        // The first output is what a host hears first: it must move clearly.
+        let first = out
+            .first()
+            .map(|ch| ch.iter().fold(0.0f64, |m, v| m.max((v - ch[0]).abs())))
+            .unwrap_or(0.0);
         println!(
-            "{name:<28} loudest output: peak excursion {:.3e}, AC RMS {:.3e}",
-            loudest.0, loudest.1
+            "{name:<28} out1 peak excursion {first:.3e} ({:.1e} × strike); loudest output: \
+             peak excursion {:.3e}, AC RMS {:.3e}",
+            first / FORCE_IMPULSE.abs(),
+            loudest.0,
+            loudest.1
         );
+        let struck = info
+            .inputs
+            .iter()
+            .any(|uses| matches!(uses.first(), Some(InputUse::Force(_))));
+        let bar = if struck {
+            FIRST_OUTPUT_MOVES * FORCE_IMPULSE.abs()
+        } else {
+            FIRST_OUTPUT_MOVES_UNSTRUCK
+        };
+        if !(first > bar) {
+            silent.push(format!(
+                "{name}: out1 barely moves when played as its header says: peak excursion \
+                 {first:e} from its rest value {:e}, not above {bar:e}{}",
+                out.first().map_or(0.0, |ch| ch[0]),
+                if struck {
+                    format!(
+                        " ({FIRST_OUTPUT_MOVES:e} × the strike {:e})",
+                        FORCE_IMPULSE.abs()
+                    )
+                } else {
+                    String::new()
+                }
+            ));
+        }
     }
+    assert!(silent.is_empty(), "{}", silent.join("\n"));
 }
 
 #[test]

@@ -347,7 +347,7 @@ impl Prepared {
     /// [`crate::host::channel`]). Each model input takes the channel its `~route` names, else
     /// the next of `order`; a position input receives its rest + signal × `position`, a force
     /// input signal × `force` × [`Prepared::force_scale`], an audio-rate parameter the raw
-    /// signal. An unfed input holds its rest.
+    /// signal (the engine adds its declared default). An unfed input holds its rest.
     pub fn fill_inputs(
         &mut self,
         host_in: &[[f64; CHUNK]; 4],
