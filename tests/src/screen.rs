@@ -148,8 +148,8 @@ impl Xvfb {
         // `-noreset`: by default the server resets when its last client disconnects and hangs
         // up on a client that connects meanwhile. Every `find_window` poll is a client, so the
         // standalone's first connection could meet a reset: its editor then failed with
-        // "XOpenDisplay() failed" and nice-plug waited forever without a window (1.5 % of
-        // starts under load).
+        // "XOpenDisplay() failed" and nice-plug waited forever without a window (14 of 762
+        // loaded starts, `scripts/starts.sh`).
         cmd.arg(format!(":{n}"))
             .args(["-screen", "0", &format!("{width}x{height}x24")])
             .args(["-nolisten", "tcp", "-noreset"])
@@ -183,8 +183,7 @@ impl Xvfb {
                 revents: 0,
             };
             // SAFETY: one valid pollfd.
-            if left.is_zero() || unsafe { libc::poll(&mut poll, 1, left.as_millis() as i32) } != 1
-            {
+            if left.is_zero() || unsafe { libc::poll(&mut poll, 1, left.as_millis() as i32) } != 1 {
                 return Err(StartError::Lost);
             }
             let mut byte = [0u8; 16];

@@ -38,7 +38,10 @@ fn run() -> u8 {
             at_rest = true;
             continue;
         }
-        if !matches!(a.as_str(), "--model" | "--out" | "--standalone" | "--seconds") {
+        if !matches!(
+            a.as_str(),
+            "--model" | "--out" | "--standalone" | "--seconds"
+        ) {
             eprintln!("{USAGE}");
             return 2;
         }

@@ -119,10 +119,7 @@ fn run() -> u8 {
             println!("  | {line}");
         }
     }
-    println!(
-        "{starts} starts in {:.0} s",
-        began.elapsed().as_secs_f64()
-    );
+    println!("{starts} starts in {:.0} s", began.elapsed().as_secs_f64());
     println!("starts={starts} failures={failures} crashes={crashes} no_window={no_window}");
     u8::from(failures > 0)
 }
