@@ -10,5 +10,8 @@ model="${1:-mesh-25x20}"
 shift || true
 cargo build --release --locked -p ressort-plugin --bin ressort-standalone
 cargo build --release --locked -p ressort-tests --bin ressort-screenshot
-target/release/ressort-screenshot --standalone target/release/ressort-standalone \
+target="${CARGO_TARGET_DIR:-target}"
+# exec: a signal sent to this script reaches ressort-screenshot itself, which stops its Xvfb
+# and the standalone on every path (its children die with it).
+exec "$target/release/ressort-screenshot" --standalone "$target/release/ressort-standalone" \
   --model "$model" "$@"

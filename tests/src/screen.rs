@@ -3,16 +3,109 @@
 //!
 //! Used by `tests/editor.rs` and by `ressort-screenshot` (see `scripts/screenshot.sh`).
 
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 use x11rb::connection::Connection;
 use x11rb::protocol::xproto::{AtomEnum, ConnectionExt, ImageFormat, ImageOrder, Window};
 
-/// An Xvfb server on a free display, stopped when dropped.
+/// A child process that does not outlive its parent: it is stopped (SIGTERM, SIGKILL if it is
+/// still there 3 s later) and reaped when the guard is dropped, and the kernel sends it SIGTERM
+/// when the thread that spawned it ends, so a parent that exits through
+/// `std::process::exit`, a panic that aborts, Ctrl+C or any other signal leaves nothing behind.
+/// SIGTERM rather than SIGKILL lets Xvfb remove its lock file and socket.
+///
+/// The signal follows the spawning *thread* (`PR_SET_PDEATHSIG`): spawn from a thread that
+/// lives as long as the child is wanted (a test's own thread, or `main`).
+#[derive(Debug)]
+pub struct ChildGuard(Child);
+
+impl ChildGuard {
+    pub fn spawn(cmd: &mut Command) -> std::io::Result<ChildGuard> {
+        // SAFETY: the closure runs between fork and exec and calls only async-signal-safe
+        // functions (prctl, getppid, kill on itself).
+        let parent = std::process::id() as libc::pid_t;
+        unsafe {
+            cmd.pre_exec(move || {
+                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM as libc::c_ulong) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                // The parent may have died before the prctl: then nobody will send it.
+                if libc::getppid() != parent {
+                    libc::kill(libc::getpid(), libc::SIGKILL);
+                }
+                Ok(())
+            });
+        }
+        cmd.spawn().map(ChildGuard)
+    }
+
+    pub fn try_wait(&mut self) -> std::io::Result<Option<ExitStatus>> {
+        self.0.try_wait()
+    }
+
+    /// Sends SIGINT, as Ctrl+C in a terminal does (nothing once the child has been reaped).
+    pub fn interrupt(&mut self) {
+        self.signal(libc::SIGINT);
+    }
+
+    fn signal(&mut self, signal: libc::c_int) {
+        if let Ok(None) = self.0.try_wait() {
+            // SAFETY: kill has no memory-safety preconditions. The child has not been reaped
+            // (try_wait just said it is running), so the pid is still its own.
+            unsafe { libc::kill(self.0.id() as libc::pid_t, signal) };
+        }
+    }
+}
+
+impl Drop for ChildGuard {
+    fn drop(&mut self) {
+        self.signal(libc::SIGTERM);
+        let deadline = Instant::now() + Duration::from_secs(3);
+        while let Ok(None) = self.0.try_wait() {
+            if Instant::now() > deadline {
+                let _ = self.0.kill();
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let _ = self.0.wait();
+    }
+}
+
+enum StartError {
+    /// Xvfb cannot be run.
+    NoXvfb,
+    /// This server did not come up on its display (another one took it first).
+    Lost,
+}
+
+/// Whether display `n` is taken: its lock file names a live process, or its socket exists
+/// without a lock file. A lock left by a server that was killed is stale: the next server on
+/// that display removes it.
+fn display_taken(n: u32) -> bool {
+    match std::fs::read_to_string(format!("/tmp/.X{n}-lock")) {
+        Ok(pid) => match pid.trim().parse::<libc::pid_t>() {
+            Ok(pid) if pid > 0 => {
+                // SAFETY: signal 0 only checks that the process exists.
+                let alive = unsafe { libc::kill(pid, 0) } == 0;
+                alive || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+            }
+            _ => true,
+        },
+        Err(_) => Path::new(&format!("/tmp/.X11-unix/X{n}")).exists(),
+    }
+}
+
+/// An Xvfb server on a free display, stopped when dropped (and killed by the kernel when the
+/// thread that started it ends: see [`ChildGuard`]).
 #[derive(Debug)]
 pub struct Xvfb {
-    child: Child,
+    // Held for its drop, which stops the server.
+    _server: ChildGuard,
+    // The `-displayfd` pipe, open while the server runs (see `start_on`).
+    _ready: std::fs::File,
     display: String,
 }
 
@@ -20,57 +113,98 @@ impl Xvfb {
     /// Starts Xvfb with a 24-bit screen of `width` × `height` on the first display number
     /// that is free. None when Xvfb is not installed or does not come up.
     pub fn start(width: u32, height: u32) -> Option<Xvfb> {
-        // Tests start servers in parallel: one at a time, and a server that exits at once
-        // (its display was taken meanwhile) moves on to the next number.
+        // Tests start servers in parallel: one at a time within a process. Other processes
+        // (another test binary, `ressort-screenshot`) may pick the same number meanwhile:
+        // the server that loses exits, and only the winner writes its number to the
+        // `-displayfd` pipe, so a server is never mistaken for another process's one.
         static STARTING: std::sync::Mutex<()> = std::sync::Mutex::new(());
         let _one_at_a_time = STARTING.lock().unwrap_or_else(|e| e.into_inner());
         for n in 90..200u32 {
-            if Path::new(&format!("/tmp/.X{n}-lock")).exists()
-                || Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
-            {
+            if display_taken(n) {
                 continue;
             }
-            let display = format!(":{n}");
-            let child = Command::new("Xvfb")
-                .arg(&display)
-                .args(["-screen", "0", &format!("{width}x{height}x24")])
-                .args(["-nolisten", "tcp"])
-                .stdout(Stdio::null())
-                .stderr(Stdio::null())
-                .spawn()
-                .ok()?;
-            let mut x = Xvfb { child, display };
-            let deadline = Instant::now() + Duration::from_secs(10);
-            while Instant::now() < deadline {
-                if let Ok(Some(_)) = x.child.try_wait() {
-                    break;
-                }
-                // Xlib clients connect through the socket file, which may appear after the
-                // abstract socket x11rb can already use.
-                let socket = Path::new("/tmp/.X11-unix").join(format!("X{n}"));
-                if socket.exists() && x11rb::connect(Some(&x.display)).is_ok() {
-                    std::thread::sleep(Duration::from_millis(200));
-                    if let Ok(None) = x.child.try_wait() {
-                        return Some(x);
-                    }
-                    break;
-                }
-                std::thread::sleep(Duration::from_millis(50));
+            match Xvfb::start_on(n, width, height) {
+                Ok(x) => return Some(x),
+                Err(StartError::NoXvfb) => return None,
+                Err(StartError::Lost) => continue,
             }
         }
         None
     }
 
+    fn start_on(n: u32, width: u32, height: u32) -> Result<Xvfb, StartError> {
+        use std::io::Read;
+        use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+        let mut fds = [0; 2];
+        // SAFETY: `fds` has room for the two descriptors pipe2 writes.
+        if unsafe { libc::pipe2(fds.as_mut_ptr(), libc::O_CLOEXEC) } != 0 {
+            return Err(StartError::NoXvfb);
+        }
+        // SAFETY: pipe2 succeeded, so both descriptors are open and owned by nobody else.
+        let (ready_read, ready_write) =
+            unsafe { (OwnedFd::from_raw_fd(fds[0]), OwnedFd::from_raw_fd(fds[1])) };
+        let write_fd = ready_write.as_raw_fd();
+        let mut cmd = Command::new("Xvfb");
+        // `-noreset`: by default the server resets when its last client disconnects and hangs
+        // up on a client that connects meanwhile. Every `find_window` poll is a client, so the
+        // standalone's first connection could meet a reset: its editor then failed with
+        // "XOpenDisplay() failed" and nice-plug waited forever without a window (14 of 762
+        // loaded starts, `scripts/starts.sh`).
+        cmd.arg(format!(":{n}"))
+            .args(["-screen", "0", &format!("{width}x{height}x24")])
+            .args(["-nolisten", "tcp", "-noreset"])
+            .args(["-displayfd", &write_fd.to_string()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null());
+        // SAFETY: fcntl is async-signal-safe; the descriptor is open until the parent drops
+        // `ready_write` after the spawn.
+        unsafe {
+            cmd.pre_exec(move || {
+                if libc::fcntl(write_fd, libc::F_SETFD, 0) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+        let child = ChildGuard::spawn(&mut cmd).map_err(|_| StartError::NoXvfb)?;
+        drop(ready_write);
+        // The server writes its display number and a newline (two writes) once it accepts
+        // connections; a server that lost the display to another one exits, and the pipe
+        // reports end of file. The reading end stays open as long as the server runs: a
+        // server that writes into a closed pipe exits.
+        let mut ready = std::fs::File::from(ready_read);
+        let mut written = Vec::new();
+        let deadline = Instant::now() + Duration::from_secs(20);
+        while !written.ends_with(b"\n") {
+            let left = deadline.saturating_duration_since(Instant::now());
+            let mut poll = libc::pollfd {
+                fd: ready.as_raw_fd(),
+                events: libc::POLLIN,
+                revents: 0,
+            };
+            // SAFETY: one valid pollfd.
+            if left.is_zero() || unsafe { libc::poll(&mut poll, 1, left.as_millis() as i32) } != 1 {
+                return Err(StartError::Lost);
+            }
+            let mut byte = [0u8; 16];
+            match ready.read(&mut byte) {
+                Ok(0) | Err(_) => return Err(StartError::Lost),
+                Ok(len) => written.extend_from_slice(&byte[..len]),
+            }
+        }
+        if String::from_utf8_lossy(&written).trim() != n.to_string() {
+            return Err(StartError::Lost);
+        }
+        Ok(Xvfb {
+            _server: child,
+            _ready: ready,
+            display: format!(":{n}"),
+        })
+    }
+
     /// The `DISPLAY` value: `:93`.
     pub fn display(&self) -> &str {
         &self.display
-    }
-}
-
-impl Drop for Xvfb {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
     }
 }
 
@@ -316,9 +450,8 @@ pub fn capture_standalone(
         cmd.arg("--audition");
     }
     let started = Instant::now();
-    let mut child = cmd
-        .spawn()
-        .map_err(|e| format!("{}: {e}", standalone.display()))?;
+    let mut child =
+        ChildGuard::spawn(&mut cmd).map_err(|e| format!("{}: {e}", standalone.display()))?;
     let output = |log: &Path| std::fs::read_to_string(log).unwrap_or_default();
     let result = (|| {
         let mut window = None;
@@ -337,9 +470,7 @@ pub fn capture_standalone(
         }
         let Some(window) = window else {
             // Ask it to stop the way Ctrl+C does, so it reports why the editor did not open.
-            let _ = Command::new("kill")
-                .args(["-INT", &child.id().to_string()])
-                .status();
+            child.interrupt();
             std::thread::sleep(Duration::from_secs(1));
             return Err(format!(
                 "no window called Ressort appeared; windows: {:?}\n{}",
@@ -376,8 +507,7 @@ pub fn capture_standalone(
             }
         }
     })();
-    let _ = child.kill();
-    let _ = child.wait();
+    drop(child);
     let _ = std::fs::remove_file(&log);
     result
 }

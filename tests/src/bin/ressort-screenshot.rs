@@ -10,11 +10,23 @@
 //! `--at-rest` does not strike and captures two seconds after the motion view appears. Exit status 0 when the plot shows motion (or, with
 //! `--at-rest`, whatever it shows), 1 when it does not, 2 on errors.
 
+//!
+//! The Xvfb and the standalone stop with this program on every path: errors return through
+//! `main` so their guards drop, and the kernel stops them if it is killed (see
+//! `screen::ChildGuard`).
+
 use ressort_tests::screen::{capture_standalone, shows_motion, standalone_path, Xvfb};
 use std::path::PathBuf;
+use std::process::ExitCode;
 use std::time::Duration;
 
-fn main() {
+fn main() -> ExitCode {
+    ExitCode::from(run())
+}
+
+const USAGE: &str = "usage: ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest]";
+
+fn run() -> u8 {
     let mut model = "mesh-25x20".to_string();
     let mut out = None;
     let mut standalone = standalone_path();
@@ -22,29 +34,32 @@ fn main() {
     let mut at_rest = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
-        let mut value = |name: &str| {
-            args.next().unwrap_or_else(|| {
-                eprintln!("ressort-screenshot: {name} needs a value");
-                std::process::exit(2)
-            })
+        if a == "--at-rest" {
+            at_rest = true;
+            continue;
+        }
+        if !matches!(
+            a.as_str(),
+            "--model" | "--out" | "--standalone" | "--seconds"
+        ) {
+            eprintln!("{USAGE}");
+            return 2;
+        }
+        let Some(value) = args.next() else {
+            eprintln!("ressort-screenshot: {a} needs a value");
+            return 2;
         };
         match a.as_str() {
-            "--model" => model = value("--model"),
-            "--out" => out = Some(PathBuf::from(value("--out"))),
-            "--standalone" => standalone = PathBuf::from(value("--standalone")),
-            "--seconds" => {
-                seconds = value("--seconds").parse().unwrap_or_else(|_| {
+            "--model" => model = value,
+            "--out" => out = Some(PathBuf::from(value)),
+            "--standalone" => standalone = PathBuf::from(value),
+            _ => match value.parse() {
+                Ok(s) => seconds = s,
+                Err(_) => {
                     eprintln!("ressort-screenshot: --seconds takes a number");
-                    std::process::exit(2)
-                })
-            }
-            "--at-rest" => at_rest = true,
-            _ => {
-                eprintln!(
-                    "usage: ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest]"
-                );
-                std::process::exit(2)
-            }
+                    return 2;
+                }
+            },
         }
     }
     let out = out.unwrap_or_else(|| {
@@ -56,7 +71,7 @@ fn main() {
     });
     let Some(x) = Xvfb::start(1280, 800) else {
         eprintln!("ressort-screenshot: Xvfb could not be started (is the xvfb package installed?)");
-        std::process::exit(2)
+        return 2;
     };
     let capture = match capture_standalone(
         &standalone,
@@ -69,12 +84,13 @@ fn main() {
         Ok(c) => c,
         Err(e) => {
             eprintln!("ressort-screenshot: {e}");
-            std::process::exit(2)
+            return 2;
         }
     };
+    drop(x);
     if let Err(e) = capture.image.save_png(&out) {
         eprintln!("ressort-screenshot: {e}");
-        std::process::exit(2)
+        return 2;
     }
     println!(
         "wrote {} ({}×{}, {:.1} s after launch)",
@@ -96,7 +112,5 @@ fn main() {
             "blank or at rest"
         }
     );
-    if !moving && !at_rest {
-        std::process::exit(1)
-    }
+    u8::from(!moving && !at_rest)
 }
