@@ -52,6 +52,19 @@ pub fn output_sample(x: f64) -> f32 {
     }
 }
 
+/// A host input sample as the model reads it: NaN, ±∞ and subnormal samples (below
+/// 1.2·10⁻³⁸, 750 dB under full scale) read 0. The test looks at the exponent bits, so a
+/// subnormal never enters an arithmetic operation: without DAZ, x86 CPUs take a slow assist for
+/// subnormal operands (FTZ flushes only results), and clap-validator feeds whole blocks of them.
+#[inline]
+pub fn input_sample(s: f32) -> f64 {
+    const EXPONENT: u32 = 0x7f80_0000;
+    match s.to_bits() & EXPONENT {
+        0 | EXPONENT => 0.0,
+        _ => s as f64,
+    }
+}
+
 /// Knee of the soft ceiling: below it the output is untouched.
 pub const CEILING_KNEE: f64 = 0.5;
 
@@ -185,6 +198,25 @@ mod tests {
             let x = 1e-45 * 1.05f64.powi(i);
             let y = output_sample(x);
             assert!(!y.is_subnormal(), "{x:e} -> {y:e}");
+        }
+    }
+
+    #[test]
+    fn inputs_read_non_finite_and_subnormal_samples_as_zero() {
+        for s in [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MIN_POSITIVE / 2.0,
+            -1e-40,
+            f32::from_bits(1),
+            0.0,
+            -0.0,
+        ] {
+            assert_eq!(input_sample(s).to_bits(), 0.0f64.to_bits(), "{s:e}");
+        }
+        for s in [f32::MIN_POSITIVE, -0.5, 1.0, 3e38, -1e-20] {
+            assert_eq!(input_sample(s), s as f64);
         }
     }
 

@@ -474,16 +474,13 @@ impl Ressort {
     }
 }
 
-/// Copies host samples from `start` into `dst` as f64; non-finite samples and samples past
-/// the channel's end read 0.
+/// Copies host samples from `start` into `dst` as f64 ([`dsp::input_sample`]: non-finite and
+/// subnormal samples read 0); samples past the channel's end read 0.
 #[inline]
 fn read_channel(dst: &mut [f64], src: &[f32], start: usize) {
     let src = src.get(start..).unwrap_or(&[]);
     for (i, d) in dst.iter_mut().enumerate() {
-        *d = match src.get(i) {
-            Some(s) if s.is_finite() => *s as f64,
-            _ => 0.0,
-        };
+        *d = src.get(i).copied().map_or(0.0, dsp::input_sample);
     }
 }
 
