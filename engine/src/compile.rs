@@ -224,6 +224,8 @@ struct Cx<'a> {
     audio_bindings: Vec<Binding>,
     /// Parameter id → audio-rate.
     param_is_audio: Vec<bool>,
+    /// Parameter id → named in a connection-point coordinate.
+    param_is_coordinate: Vec<bool>,
     /// Element index → first point (single masses, avatars) or first node (macros).
     element_point: Vec<Option<u32>>,
     proxies: Proxies,
@@ -421,6 +423,13 @@ impl<'a> Cx<'a> {
                     return None;
                 }
                 let base = self.element_point[j]?;
+                for c in &coords {
+                    c.for_each_name(&mut |n| {
+                        if let Some(Symbol::Param(id)) = self.symbols.get(n) {
+                            self.param_is_coordinate[*id as usize] = true;
+                        }
+                    });
+                }
                 let zero = Expr::Num(0.0);
                 let (s0, audio0) = self.slot(coords[0], ArgClass::None, element);
                 let (s1, audio1) = self.slot(
@@ -514,6 +523,7 @@ impl<'a> Compiler<'a> {
                 control_bindings: Vec::new(),
                 audio_bindings: Vec::new(),
                 param_is_audio: Vec::new(),
+                param_is_coordinate: Vec::new(),
                 element_point: vec![None; spec.elements.len()],
                 proxies: Proxies::default(),
                 proxy_audio: Vec::new(),
@@ -613,10 +623,12 @@ impl<'a> Compiler<'a> {
             };
             params.push(if value.is_finite() { value } else { 0.0 });
             self.param_is_audio.push(audio_input.is_some());
+            self.param_is_coordinate.push(false);
             param_info.push(ParamInfo {
                 name: p.name.clone(),
                 default: value,
                 audio_input,
+                coordinate: false,
             });
         }
 
@@ -1035,7 +1047,11 @@ impl<'a> Compiler<'a> {
             num_interactions,
             points,
             owners,
-            params: param_info,
+            params: param_info
+                .into_iter()
+                .zip(&cx.param_is_coordinate)
+                .map(|(p, &coordinate)| ParamInfo { coordinate, ..p })
+                .collect(),
             inputs,
             outputs,
             motion,

@@ -644,10 +644,8 @@ pub struct Engine {
 /// An error setting a parameter.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ParamError {
-    /// No control-rate parameter has that id.
+    /// No parameter has that id.
     UnknownParam(u32),
-    /// Audio-rate parameters take their value from an input.
-    AudioRate(u32),
     /// The value is NaN or infinite.
     NonFinite(f64),
 }
@@ -656,9 +654,6 @@ impl std::fmt::Display for ParamError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             ParamError::UnknownParam(id) => write!(f, "no parameter with id {id}"),
-            ParamError::AudioRate(id) => {
-                write!(f, "parameter {id} is audio-rate and follows its input")
-            }
             ParamError::NonFinite(v) => write!(f, "parameter value {v} is not finite"),
         }
     }
@@ -699,28 +694,36 @@ impl Engine {
             .map(|i| ParamId(i as u32))
     }
 
-    /// The current value of a parameter (an audio-rate one holds its default plus its last
-    /// input sample, and its default before the first sample).
+    /// The current value of a parameter. An audio-rate one holds its default plus its last
+    /// input sample; before the first sample, and from [`Engine::set_param`] to the next
+    /// sample, it holds its default.
     pub fn param(&self, id: ParamId) -> Option<f64> {
         self.params.get(id.0 as usize).copied()
     }
 
-    /// Sets a control-rate parameter. It takes effect at the start of the next
-    /// [`Engine::process`] call (spec §3.5). Realtime-safe.
+    /// Sets a parameter. It takes effect at the start of the next [`Engine::process`] call
+    /// (spec §3.5), or at [`Engine::apply_pending_changes`]. For an audio-rate parameter
+    /// (`audioParam @inN default`) it sets the default, the centre its input modulates
+    /// around: from the next sample on the parameter is `value` + input N. Realtime-safe.
     pub fn set_param(&mut self, id: ParamId, value: f64) -> Result<(), ParamError> {
-        let info = self
-            .info
-            .params
-            .get(id.0 as usize)
-            .ok_or(ParamError::UnknownParam(id.0))?;
-        if info.audio_input.is_some() {
-            return Err(ParamError::AudioRate(id.0));
+        let i = id.0 as usize;
+        if i >= self.params.len() {
+            return Err(ParamError::UnknownParam(id.0));
         }
         if !value.is_finite() {
             return Err(ParamError::NonFinite(value));
         }
-        if self.params[id.0 as usize] != value {
-            self.params[id.0 as usize] = value;
+        if let Some(r) = self.audio_params.iter().position(|r| r.index == id.0) {
+            // The default is read at every sample (stage 1 b), so it acts from the first
+            // sample of the next block. The value itself becomes the default until then, so
+            // the stability analysis and a reset see the new centre.
+            if self.audio_defaults[r] != value {
+                self.audio_defaults[r] = value;
+                self.params[i] = value;
+                self.params_dirty = true;
+            }
+        } else if self.params[i] != value {
+            self.params[i] = value;
             self.params_dirty = true;
         }
         Ok(())

@@ -47,6 +47,9 @@ pub struct ParamInfo {
     pub default: f64,
     /// The 1-based input channel of an audio-rate parameter.
     pub audio_input: Option<u32>,
+    /// True when the parameter is named in a connection-point coordinate (`[@m lX lY]`): it
+    /// places a point along a macro, so its useful values are 0 … 1.
+    pub coordinate: bool,
 }
 
 /// What an input channel drives.

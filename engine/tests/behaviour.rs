@@ -228,6 +228,79 @@ fn audio_rate_parameters_are_their_default_plus_their_input() {
     assert_eq!(parsed.spec.as_ref(), Some(&spec));
 }
 
+/// A membrane struck on in1 and heard at (lX, 0.6), lX an `audioParam` on in2 with `default`.
+fn listening_point(default: f64) -> ressort_engine::Engine {
+    let text = format!(
+        "@lX audioParam @in2 {default}\n@lY audioParam @in3 0.6\n\
+         @m closedMesh 12 12 1 0.1 0.001 0 0\n@in1 frcInput [@m 0.8 0.7]\n\
+         @out1 posOutput [@m lX lY]\n"
+    );
+    let spec = ressort_engine::parse(&text).spec.expect("valid script");
+    engine(&spec, 48_000.0)
+}
+
+/// `set_param` on an `audioParam` sets its default: a model compiled at 0.2 and set to 0.7
+/// renders bit for bit what the model written with 0.7 renders, with its input silent or
+/// modulating around the new centre, in one block or sample by sample.
+#[test]
+fn setting_an_audio_rate_parameter_moves_its_default() {
+    let frames = 3000;
+    let lx_signal: Vec<f64> = (0..frames)
+        .map(|n| 0.05 * (n as f64 * 0.002).sin())
+        .collect();
+    for inputs in [
+        vec![impulse(-0.01, frames)],
+        vec![impulse(-0.01, frames), lx_signal],
+    ] {
+        let mut written = listening_point(0.7);
+        let expected = render(&mut written, frames, frames, &inputs);
+        let mut set = listening_point(0.2);
+        let id = set.param_id("lX").unwrap();
+        assert_eq!(set.param(id), Some(0.2));
+        set.set_param(id, 0.7).unwrap();
+        // The new default is the value until the next sample reads the input.
+        assert_eq!(set.param(id), Some(0.7));
+        assert_eq!(set.info().params[id.0 as usize].default, 0.2);
+        let got = render(&mut set, frames, 1, &inputs);
+        assert_eq!(hash_f64s(&got[0]), hash_f64s(&expected[0]));
+        assert_eq!(got, expected);
+        // And the old default would not have done.
+        let mut old = listening_point(0.2);
+        assert_ne!(render(&mut old, frames, frames, &inputs), expected);
+    }
+    assert!(listening_point(0.3).info().params[0].coordinate);
+    let k = ressort_engine::parse("@K param 0.1\n@m mass 1 0 0\n@g ground 0\n@s spring @m @g K\n");
+    let k = engine(&k.spec.unwrap(), 48_000.0);
+    assert!(!k.info().params[0].coordinate);
+}
+
+/// A default changed between blocks acts from the next block's first sample, as a control
+/// parameter does: blocks of 64 and single samples agree bit for bit.
+#[test]
+fn an_audio_rate_default_changes_at_the_block_boundary() {
+    let frames = 2048;
+    let inputs = [impulse(-0.01, frames)];
+    let run = |block: usize| {
+        let mut e = listening_point(0.3);
+        let id = e.param_id("lX").unwrap();
+        let mut out = vec![0.0; frames];
+        let mut buf = vec![0.0; block];
+        for start in (0..frames).step_by(block) {
+            // Change every 512 samples; a repeated value changes nothing.
+            e.set_param(id, 0.3 + 0.1 * (start / 512) as f64).unwrap();
+            e.process(block, &inputs[0][start..start + block], &mut buf);
+            out[start..start + block].copy_from_slice(&buf);
+        }
+        out
+    };
+    let (a, b) = (run(64), run(1));
+    assert_eq!(a, b);
+    let mut fixed = listening_point(0.3);
+    let c = render(&mut fixed, frames, frames, &inputs);
+    assert_eq!(a[..512], c[0][..512]);
+    assert_ne!(a[512..], c[0][512..]);
+}
+
 #[test]
 fn class_gain_scales_every_stiffness() {
     // A stiffness gain of 4 on a string doubles its pitch (K ∝ f² for low modes).
