@@ -1,17 +1,18 @@
-//! Macro slots: the model's control-rate `param`s bound to the generic host parameters, with
-//! ranges the stability analysis accepts.
+//! Macro slots: the model's `param`s and `audioParam`s bound to the generic host parameters,
+//! with ranges the stability analysis accepts.
 
 use crate::envelope::{worst_load, STABILITY_HEADROOM};
 use crate::host::HostSettings;
 use crate::model::NUM_MACROS;
 use ressort_engine::{Engine, ParamId};
 
-/// A macro slot bound to one of the model's `param`s.
+/// A macro slot bound to one of the model's `param`s or `audioParam`s. For an `audioParam`
+/// the slot sets its default, the centre its input modulates around.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MacroBinding {
     pub param: ParamId,
     pub name: String,
-    /// The declared value: the slot's centre (normalized 0.5).
+    /// The declared value (an `audioParam`'s default): the slot's centre (normalized 0.5).
     pub default: f64,
     pub min: f64,
     pub max: f64,
@@ -59,27 +60,37 @@ impl MacroBinding {
     }
 }
 
-/// Binds the macro slots to the model's control-rate `param`s in declaration order, with the
-/// script's ranges or a default range around the declared value that the stability analysis
-/// accepts.
+/// Binds the macro slots to the model's parameters, `param`s and `audioParam`s alike, in
+/// strict declaration order, with the script's ranges or a default range around the declared
+/// value that the stability analysis accepts. An `audioParam` slot moves its default.
 pub fn macro_bindings(engine: &mut Engine, settings: &HostSettings) -> Vec<Option<MacroBinding>> {
-    let params: Vec<(usize, String, f64)> = engine
+    let params: Vec<(usize, String, f64, bool)> = engine
         .info()
         .params
         .iter()
         .enumerate()
-        .filter(|(_, p)| p.audio_input.is_none())
-        .map(|(i, p)| (i, p.name.clone(), p.default))
+        .map(|(i, p)| {
+            let position = p.audio_input.is_some() && p.coordinate;
+            (i, p.name.clone(), p.default, position)
+        })
         .collect();
     let mut out: Vec<Option<MacroBinding>> = vec![None; NUM_MACROS];
     let base_stable = engine.stability().is_stable();
-    for (slot, (index, name, default)) in params.into_iter().take(NUM_MACROS).enumerate() {
+    for (slot, (index, name, default, position)) in params.into_iter().take(NUM_MACROS).enumerate()
+    {
         let id = ParamId(index as u32);
         let declared = settings.macro_ranges.iter().find(|r| r.name == name);
         let (min, max) = match declared {
             Some(r) => (r.min, r.max),
             None => {
-                let (lo, hi) = default_range(default);
+                // An audio-rate connection-point coordinate spans the macro: 0 … 1 (the
+                // engine clamps coordinates there). The bisection still keeps its ends
+                // stable, since moving a contact moves where its stiffness lands.
+                let (lo, hi) = if position {
+                    (0.0, 1.0)
+                } else {
+                    default_range(default)
+                };
                 let hi = if base_stable {
                     stable_towards(engine, id, default, hi)
                 } else {

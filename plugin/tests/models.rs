@@ -283,3 +283,79 @@ fn every_preset_moves_its_first_output_when_played() {
     }
     assert!(silent.is_empty(), "{}", silent.join("\n"));
 }
+
+/// Chladni's listening point is two knobs: the `audioParam`s `lX` and `lY` take Macro slots in
+/// declaration order (after the six `param`s above them), range 0 … 1 as coordinates, and
+/// moving the `lX` slot moves where out1 listens, while `in3` stays unfed.
+#[test]
+fn chladni_listening_point_is_a_macro_knob() {
+    const FRAMES: usize = 6000;
+    let preset = Preset::find("chladni-150x150").unwrap();
+    let render = |lx_slot: Option<f64>| {
+        let mut p = prepare(preset.id, preset.text, 48_000.0).unwrap();
+        let names: Vec<&str> = p
+            .macros
+            .iter()
+            .map(|b| b.as_ref().map_or("", |b| b.name.as_str()))
+            .collect();
+        assert_eq!(
+            names[..11],
+            [
+                "meshK",
+                "meshZ",
+                "meshZo",
+                "eX",
+                "eY",
+                "contactStiffness",
+                "lX",
+                "lY",
+                "cX",
+                "cY",
+                "pM"
+            ]
+        );
+        let lx = p.macros[6].clone().unwrap();
+        let ly = p.macros[7].as_ref().unwrap();
+        assert_eq!((lx.min, lx.default, lx.max), (0.0, 0.3, 1.0));
+        assert_eq!((ly.min, ly.default, ly.max), (0.0, 0.6, 1.0));
+        if let Some(n) = lx_slot {
+            p.engine.set_param(lx.param, lx.value_at(n)).unwrap();
+        }
+        let n_in = p.roles.len();
+        let n_out = p.outputs.len() / CHUNK;
+        let k = p.note_input.expect("a note input");
+        let strike = p.settings.note_force * p.strike_scale;
+        let mut out1 = Vec::with_capacity(FRAMES);
+        for block in 0..FRAMES / CHUNK {
+            p.inputs.fill(0.0);
+            if block == 0 {
+                p.inputs[k * CHUNK] = strike;
+            }
+            let report = p.engine.process(
+                CHUNK,
+                &p.inputs[..n_in * CHUNK],
+                &mut p.outputs[..n_out * CHUNK],
+            );
+            assert!(!report.tripped);
+            out1.extend_from_slice(&p.outputs[..CHUNK]);
+        }
+        out1
+    };
+    let centre = render(None);
+    let peak = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(
+        peak(&centre) > 0.0,
+        "the strike does not reach the listening point"
+    );
+    // The slot's centre is the declared default: nothing changes.
+    assert_eq!(render(Some(0.5)), centre);
+    let moved = render(Some(0.9));
+    let diff: Vec<f64> = moved.iter().zip(&centre).map(|(a, b)| a - b).collect();
+    println!(
+        "out1 peak {:.3e} at lX = 0.3, {:.3e} at the slot's 0.9; difference {:.3e}",
+        peak(&centre),
+        peak(&moved),
+        peak(&diff)
+    );
+    assert!(peak(&diff) > 0.1 * peak(&centre));
+}
