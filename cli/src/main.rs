@@ -263,7 +263,6 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
             let names: Vec<&str> = info
                 .params
                 .iter()
-                .filter(|p| p.audio_input.is_none())
                 .map(|p| p.name.as_str())
                 .collect();
             usage(format!(
