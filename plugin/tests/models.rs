@@ -66,7 +66,7 @@ fn the_stiffness_limit_matches_the_stability_analysis() {
 }
 
 /// Asking for ×16 stiffness and ×16 damping on every preset gives clamped gains under which
-/// the model runs for a second, struck, without the guard tripping.
+/// the model runs for a second, struck, without the guard tripping and with finite outputs.
 #[test]
 fn clamped_gains_keep_every_preset_running() {
     for preset in PRESETS {
@@ -94,9 +94,19 @@ fn clamped_gains_keep_every_preset_running() {
                 &mut p.outputs[..n_out * CHUNK],
             );
             assert!(!report.tripped, "{} exploded at ×{gk}", preset.id);
-            peak = p.outputs.iter().fold(peak, |a, x| a.max(x.abs()));
+            // Every sample, before the peak: `f64::max` drops a NaN, so a peak never sees one.
+            let outs = &p.outputs[..n_out * CHUNK];
+            if let Some(i) = outs.iter().position(|x| !x.is_finite()) {
+                panic!(
+                    "{} at ×{gk}/×{gz}: output {} is {} in block {block}",
+                    preset.id,
+                    i / CHUNK + 1,
+                    outs[i]
+                );
+            }
+            peak = outs.iter().fold(peak, |a, x| a.max(x.abs()));
         }
-        assert!(peak.is_finite());
+        println!("{:<20} output peak {peak:.3e}", "");
     }
 }
 
