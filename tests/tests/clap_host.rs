@@ -834,8 +834,7 @@ fn midi_notes_play_at_the_expected_pitch() {
     );
 
     // The hammer oscillator at ≈ 2.2 kHz, where the exact law and its low-frequency limit
-    // 2^(st/6) part by 19 cents per octave at 48 kHz. Which one applies depends on whether the
-    // plugin knows the model's reference pitch; report what happens. A note's force (0.02)
+    // 2^(st/6) part by 19 cents per octave at 48 kHz. A note's force (0.02)
     // does not throw this preset's damped hammer onto the oscillator (see
     // `every_preset_sounds_on_a_midi_note`): Force Gain +12 dB makes it 0.08.
     let gain = [
@@ -867,19 +866,18 @@ fn midi_notes_play_at_the_expected_pitch() {
         cents(h60, model).abs() < 1.0,
         "note 60 must play the model as written"
     );
-    let exact = cents(ratio, 2.0).abs() < 3.0;
-    let low_frequency = cents(ratio, low_frequency_law).abs() < 3.0;
-    if !exact && low_frequency {
-        println!(
-            "NOTE: the plugin has no reference pitch for this model and tunes by 2^(st/6): \
-             note 72 sounds {:+.1} cents sharp of an octave above note 60",
-            cents(ratio, 2.0)
-        );
-    }
+    // The plugin measures this model's reference pitch and tunes by the exact law
+    // (`dsp::tuning_gain`): note 72 is an octave. The 3-cent tolerance is far inside the
+    // 19 cents by which the low-frequency law 2^(st/6) would miss it.
     assert!(
-        exact || low_frequency,
-        "note 72 / note 60 = {ratio:.5} follows neither the exact law (2) nor the \
-         low-frequency law ({low_frequency_law:.5})"
+        cents(low_frequency_law, 2.0).abs() > 3.0 * 3.0,
+        "the two laws are too close here to tell apart"
+    );
+    assert!(
+        cents(ratio, 2.0).abs() < 3.0,
+        "note 72 / note 60 = {ratio:.5} ({:+.2} cents from an octave) does not follow the \
+         exact law; the low-frequency law 2^(st/6) gives {low_frequency_law:.5}",
+        cents(ratio, 2.0)
     );
 }
 
