@@ -260,11 +260,7 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
             .parse()
             .map_err(|_| usage(format!("`{value}` is not a number (in --set {s})")))?;
         let id = engine.param_id(name).ok_or_else(|| {
-            let names: Vec<&str> = info
-                .params
-                .iter()
-                .map(|p| p.name.as_str())
-                .collect();
+            let names: Vec<&str> = info.params.iter().map(|p| p.name.as_str()).collect();
             usage(format!(
                 "unknown parameter `{name}`; the model's parameters are: {}",
                 if names.is_empty() {

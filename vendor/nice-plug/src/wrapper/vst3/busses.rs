@@ -26,7 +26,11 @@ pub struct BusDesc {
 /// largest one has.
 fn shape(layouts: &[AudioIOLayout], input: bool) -> (bool, usize) {
     let main = layouts.iter().any(|l| main_channels(l, input) > 0);
-    let aux = layouts.iter().map(|l| aux_ports(l, input).len()).max().unwrap_or(0);
+    let aux = layouts
+        .iter()
+        .map(|l| aux_ports(l, input).len())
+        .max()
+        .unwrap_or(0);
     (main, aux)
 }
 
@@ -60,7 +64,12 @@ pub fn aux_start(layouts: &[AudioIOLayout], input: bool) -> usize {
 
 /// The channel count `layout` gives the host's bus `index` in direction `input`; 0 when the
 /// layout does not have that bus.
-pub fn channels_in(layouts: &[AudioIOLayout], layout: &AudioIOLayout, input: bool, index: usize) -> u32 {
+pub fn channels_in(
+    layouts: &[AudioIOLayout],
+    layout: &AudioIOLayout,
+    input: bool,
+    index: usize,
+) -> u32 {
     let (main, _) = shape(layouts, input);
     if main && index == 0 {
         return main_channels(layout, input);
@@ -114,7 +123,11 @@ pub fn describe(layouts: &[AudioIOLayout], input: bool, index: usize) -> Option<
 
 /// The first layout whose busses are exactly the present ones with these channel counts:
 /// `inputs[i]` and `outputs[i]` are the counts of the host's busses, 0 for an absent one.
-pub fn matching(layouts: &[AudioIOLayout], inputs: &[u32], outputs: &[u32]) -> Option<AudioIOLayout> {
+pub fn matching(
+    layouts: &[AudioIOLayout],
+    inputs: &[u32],
+    outputs: &[u32],
+) -> Option<AudioIOLayout> {
     layouts
         .iter()
         .find(|layout| {
@@ -234,10 +247,23 @@ mod tests {
         assert_eq!(count(LAYOUTS, false), 1);
         assert_eq!(aux_start(LAYOUTS, true), 1);
         let main = describe(LAYOUTS, true, 0).unwrap();
-        assert_eq!((main.main, main.channels, main.name.as_str(), main.default_active), (true, 2, "Input", false));
+        assert_eq!(
+            (
+                main.main,
+                main.channels,
+                main.name.as_str(),
+                main.default_active
+            ),
+            (true, 2, "Input", false)
+        );
         let sidechain = describe(LAYOUTS, true, 1).unwrap();
         assert_eq!(
-            (sidechain.main, sidechain.channels, sidechain.name.as_str(), sidechain.default_active),
+            (
+                sidechain.main,
+                sidechain.channels,
+                sidechain.name.as_str(),
+                sidechain.default_active
+            ),
             (false, 2, "Sidechain", true)
         );
         let out = describe(LAYOUTS, false, 0).unwrap();
@@ -248,14 +274,23 @@ mod tests {
     #[test]
     fn present_busses_choose_the_layout() {
         let name = |l: Option<AudioIOLayout>| l.and_then(|l| l.names.layout);
-        assert_eq!(name(matching(LAYOUTS, &[0, 2], &[2])), Some("Instrument with sidechain"));
-        assert_eq!(name(matching(LAYOUTS, &[2, 2], &[2])), Some("Effect with sidechain"));
+        assert_eq!(
+            name(matching(LAYOUTS, &[0, 2], &[2])),
+            Some("Instrument with sidechain")
+        );
+        assert_eq!(
+            name(matching(LAYOUTS, &[2, 2], &[2])),
+            Some("Effect with sidechain")
+        );
         assert_eq!(name(matching(LAYOUTS, &[2, 0], &[2])), Some("Effect"));
         assert_eq!(name(matching(LAYOUTS, &[1, 2], &[2])), None);
         assert_eq!(name(matching(LAYOUTS, &[2], &[2])), None);
 
         let mut host = HostBusses::new(LAYOUTS);
-        assert_eq!(name(host.layout(LAYOUTS)), Some("Instrument with sidechain"));
+        assert_eq!(
+            name(host.layout(LAYOUTS)),
+            Some("Instrument with sidechain")
+        );
         host.input_active[0] = true;
         assert_eq!(name(host.layout(LAYOUTS)), Some("Effect with sidechain"));
         host.input_active[1] = false;

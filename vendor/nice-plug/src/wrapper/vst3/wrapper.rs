@@ -171,7 +171,13 @@ impl<P: Vst3Plugin> IComponentTrait for Wrapper<P> {
                     && (d == K_BUS_DIRECTION_INPUT || d == K_BUS_DIRECTION_OUTPUT) =>
             {
                 let Some(bus) = (index >= 0)
-                    .then(|| busses::describe(P::AUDIO_IO_LAYOUTS, d == K_BUS_DIRECTION_INPUT, index as usize))
+                    .then(|| {
+                        busses::describe(
+                            P::AUDIO_IO_LAYOUTS,
+                            d == K_BUS_DIRECTION_INPUT,
+                            index as usize,
+                        )
+                    })
                     .flatten()
                 else {
                     return kInvalidArgument;
@@ -181,7 +187,11 @@ impl<P: Vst3Plugin> IComponentTrait for Wrapper<P> {
                 let info = unsafe { &mut *info };
                 info.mediaType = K_MEDIA_TYPE_AUDIO;
                 info.direction = dir;
-                info.busType = if bus.main { K_BUS_TYPE_MAIN } else { K_BUS_TYPE_AUX };
+                info.busType = if bus.main {
+                    K_BUS_TYPE_MAIN
+                } else {
+                    K_BUS_TYPE_AUX
+                };
                 info.channelCount = bus.channels as i32;
                 u16strlcpy(&mut info.name, &bus.name);
                 #[allow(clippy::unnecessary_cast)]
@@ -784,7 +794,11 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
         host.output_channels = output_counts;
         if !self.inner.is_processing.load(Ordering::SeqCst) {
             let layout = host.layout(P::AUDIO_IO_LAYOUTS).or_else(|| {
-                busses::matching(P::AUDIO_IO_LAYOUTS, &host.input_channels, &host.output_channels)
+                busses::matching(
+                    P::AUDIO_IO_LAYOUTS,
+                    &host.input_channels,
+                    &host.output_channels,
+                )
             });
             if let Some(layout) = layout {
                 self.inner.current_audio_io_layout.store(layout);
