@@ -26,30 +26,13 @@ const HAMMER_OSC_K: f64 = 0.1;
 /// A single, lightly damped oscillator struck directly by `@in1` (and by MIDI notes): a linear
 /// model whose pitch follows the exact law, low enough (≈ 222 Hz) that the law's bend is far
 /// below a cent for an octave.
-const LOW_OSCILLATOR: &str = "\
-# A single oscillator at about 222 Hz, struck directly by in1 (end-to-end pitch tests).
-@o osc 1. 0.001 0.00001 0. 0.
-@in1 frcInput @o
-@out1 posOutput @o
-";
+const LOW_OSCILLATOR: &str = include_str!("../models/low-oscillator.mdl");
 const LOW_OSC_M: f64 = 1.0;
 const LOW_OSC_K: f64 = 0.001;
 
 /// A small membrane with two `param`s (bound to Macro 1 and 2): a non-default model for the
 /// state tests.
-const SMALL_MESH: &str = "\
-# A 9 x 7 membrane struck by a hammer (end-to-end state tests).
-@K param 0.08
-@Z param 0.002
-@mesh cornerMesh 9 7 1. K Z 0. 0.
-@gh ground 0.1
-@h mass 1. 0.1 0.
-@sh springDamper @gh @h 0.0001 0.05
-@hit contact [@mesh 0.3 0.2] @h 0.1 0.001
-@in1 frcInput @h
-@out1 posOutput [@mesh 0.75 0.6]
-@out2 posOutput [@mesh 0.4 0.5]
-";
+const SMALL_MESH: &str = include_str!("../models/small-mesh.mdl");
 
 /// The engine's chunk: controls change at multiples of this many samples from activation.
 const CHUNK: usize = 16;

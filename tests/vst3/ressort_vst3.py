@@ -24,6 +24,11 @@ def bundle() -> Path:
     return path
 
 
+def shared_script(name: str) -> str:
+    """A script of tests/models/, shared with the CLAP end-to-end tests."""
+    return (REPO / "tests" / "models" / name).read_text()
+
+
 def model_state(name: str, script: str, params: dict | None = None) -> bytes:
     """A plugin state (nice-plug's JSON) that loads `script` as the running model and sets
     the given float parameters (plain values by id); the others keep their defaults."""

@@ -21,44 +21,23 @@ from ressort_vst3 import (
     model_state,
     oscillator_frequency,
     peak_frequency,
+    shared_script,
     write_vstpreset,
 )
 
 SR = 48_000
 
-#: One oscillator (M = 1, K = 0.001, about 222 Hz) that MIDI notes strike directly.
-OSCILLATOR = """\
-# A single oscillator at about 222 Hz, struck directly by in1 (VST3 host tests).
-@o osc 1. 0.001 0.00001 0. 0.
-@in1 frcInput @o
-@out1 posOutput @o
-"""
+#: One oscillator (M = 1, K = 0.001, about 222 Hz) that MIDI notes strike directly, and a
+#: small membrane with two bound macros (a model other than the default, for the state test).
+#: The CLAP end-to-end tests play the same scripts.
+OSCILLATOR = shared_script("low-oscillator.mdl")
 OSC_M, OSC_K = 1.0, 0.001
+SMALL_MESH = shared_script("small-mesh.mdl")
 
-#: A small membrane with two bound macros: a model other than the default for state tests.
-SMALL_MESH = """\
-# A 9 x 7 membrane struck by a hammer (VST3 state tests).
-@K param 0.08
-@Z param 0.002
-@mesh cornerMesh 9 7 1. K Z 0. 0.
-@gh ground 0.1
-@h mass 1. 0.1 0.
-@sh springDamper @gh @h 0.0001 0.05
-@hit contact [@mesh 0.3 0.2] @h 0.1 0.001
-@in1 frcInput @h
-@out1 posOutput [@mesh 0.75 0.6]
-@out2 posOutput [@mesh 0.4 0.5]
-"""
 
 def routed_oscillator(source: str) -> str:
-    """The oscillator, struck by in1, with in1 fed by one host channel (`~route`)."""
-    return f"""\
-# An oscillator struck by in1, which the host channel {source} feeds (VST3 layout tests).
-@o osc 1. 0.001 0.00001 0. 0.
-@in1 frcInput @o
-@out1 posOutput @o
-~route in1 {source}
-"""
+    """The oscillator, with its in1 fed by one host channel (`~route`)."""
+    return OSCILLATOR + f"~route in1 {source}\n"
 
 
 #: A sidechain click that strikes the default model (Mesh 15x15: in1 pushes a hammer onto the

@@ -163,6 +163,25 @@ pub(crate) enum NumberError {
     NonFinite,
 }
 
+impl NumberError {
+    /// The diagnostic category of the rejection.
+    pub(crate) fn code(self) -> DiagnosticCode {
+        match self {
+            NumberError::Invalid => DiagnosticCode::InvalidNumber,
+            NumberError::NonFinite => DiagnosticCode::NonFiniteNumber,
+        }
+    }
+}
+
+/// A token read as a numeric literal ([`parse_number_literal`]); a bracketed item never is one.
+pub(crate) fn token_number_literal(t: &super::lexer::Token) -> Result<f64, NumberError> {
+    if t.kind == super::lexer::TokKind::Bracket {
+        Err(NumberError::Invalid)
+    } else {
+        parse_number_literal(&t.text)
+    }
+}
+
 fn to_f64(chars: &[char]) -> Result<f64, NumberError> {
     let s: String = chars.iter().collect();
     match s.parse::<f64>() {

@@ -8,8 +8,7 @@
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::expr_parser::{
-    is_identifier, parse_expression, parse_number_literal, ExprContext, NumberError, SymKind,
-    Symbol, Symbols,
+    is_identifier, parse_expression, token_number_literal, ExprContext, SymKind, Symbol, Symbols,
 };
 use super::generate::{self, GenRequest, Read, MAX_GENERATED_ELEMENTS};
 use super::legacy;
@@ -1091,21 +1090,12 @@ impl Builder<'_> {
             return (Some(args), None);
         }
         let coord = |t: &Token, this: &mut Self| -> Option<f64> {
-            let r = if t.kind == TokKind::Bracket {
-                Err(NumberError::Invalid)
-            } else {
-                parse_number_literal(&t.text)
-            };
-            match r {
+            match token_number_literal(t) {
                 Ok(v) => Some(v),
                 Err(e) => {
-                    let code = match e {
-                        NumberError::Invalid => DiagnosticCode::InvalidNumber,
-                        NumberError::NonFinite => DiagnosticCode::NonFiniteNumber,
-                    };
                     this.diags.push(
                         at.diag(
-                            code,
+                            e.code(),
                             t.col,
                             format!(
                                 "the coordinates of the legacy buffer tag `{name_s}` must be \

@@ -4,7 +4,9 @@
 use super::{At, Builder, Shape};
 use crate::expr::Func;
 use crate::lang::diagnostics::DiagnosticCode;
-use crate::lang::expr_parser::{is_identifier, parse_number_literal, NumberError};
+use crate::lang::expr_parser::{
+    is_identifier, parse_number_literal, token_number_literal, NumberError,
+};
 use crate::lang::lexer::{TokKind, Token};
 use crate::spec::{ParamDecl, ParamKind, Span};
 
@@ -92,29 +94,18 @@ impl Builder<'_> {
     /// A numeric literal with an optional sign (a `param` value, an `audioParam` default),
     /// or a diagnostic at its column.
     fn literal(&mut self, v: &Token, what: &str, at: At<'_>) -> Option<f64> {
-        let r = if v.kind == TokKind::Bracket {
-            Err(NumberError::Invalid)
-        } else {
-            parse_number_literal(&v.text)
-        };
-        match r {
+        match token_number_literal(v) {
             Ok(value) => Some(value),
             Err(e) => {
-                let (code, message) = match e {
-                    NumberError::Invalid => (
-                        DiagnosticCode::InvalidNumber,
-                        format!(
-                            "{what} is a numeric literal with an optional sign, found `{}`",
-                            v.source()
-                        ),
+                let message = match e {
+                    NumberError::Invalid => format!(
+                        "{what} is a numeric literal with an optional sign, found `{}`",
+                        v.source()
                     ),
-                    NumberError::NonFinite => (
-                        DiagnosticCode::NonFiniteNumber,
-                        format!("non-finite number `{}`", v.source()),
-                    ),
+                    NumberError::NonFinite => format!("non-finite number `{}`", v.source()),
                 };
                 self.diags.push(
-                    at.diag(code, v.col, message)
+                    at.diag(e.code(), v.col, message)
                         .with_expected("a number such as `0.5` or `-1e-3`")
                         .with_found(v.source()),
                 );
