@@ -3,7 +3,8 @@
 //! The mass-interaction physics core of Ressort: every element of the mi-gen~ toolbox with the
 //! equations of the reference specification (`shared/reference/mass-interaction.md`), a model
 //! spec with a Rust builder, a compiler to flat per-kind arrays, a realtime simulation, stability
-//! analysis and lock-free motion buffers. Plain Rust: no plugin or GUI dependency.
+//! analysis, lock-free motion buffers, and the [`instrument`] that plays a model as the plugin
+//! and the command line do. Plain Rust: no plugin or GUI dependency.
 //!
 //! ```
 //! use ressort_engine::{compile, CompileOptions, Endpoint, ModelBuilder};
@@ -25,6 +26,7 @@ pub mod engine;
 pub mod expr;
 pub mod generators;
 pub mod info;
+pub mod instrument;
 pub mod lang;
 pub mod laws;
 pub mod motion;

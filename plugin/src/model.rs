@@ -8,31 +8,20 @@
 //! so it never allocates or frees. A script with errors never replaces the running model; its
 //! diagnostics are kept in [`ModelStore::status`] for the editor.
 
-use crate::envelope::{envelope, raw_envelope, worst_load};
-pub use crate::envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
-use crate::host::HostSettings;
-use crate::macros::macro_bindings;
-pub use crate::macros::MacroBinding;
-use crate::motion::{motion_channel, MotionReader, MotionWriter};
+use crate::motion::{motion_channel, MotionReader};
 use crate::param_text;
 use crate::runtime::RuntimeStatus;
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::params::persist::PersistentField;
-use ressort_engine::{
-    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, RouteSource, SampleRateMode,
-    REFERENCE_SAMPLE_RATE_HZ,
+use ressort_engine::instrument;
+pub use ressort_engine::instrument::{
+    parse_script, peak_frequency, HostSettings, InputRole, LoadLine, MacroBinding, Prepared,
+    Rejected, StabilityEnvelope, CHUNK, NUM_MACROS, STABILITY_HEADROOM,
 };
+use ressort_engine::InputUse;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
-
-/// The engine runs in chunks of at most this many samples; gains and macros are updated at
-/// chunk boundaries (counted from activation, so results do not depend on the host's block
-/// size).
-pub const CHUNK: usize = 16;
-
-/// The number of generic macro slots.
-pub const NUM_MACROS: usize = 16;
 
 /// The saved part of the model: the script of the running model and where it came from.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -43,58 +32,17 @@ pub struct ModelState {
     pub script: String,
 }
 
-/// What a model input carries, which decides its gain.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum InputRole {
-    /// A `frcInput`: × Force gain.
-    Force,
-    /// A `posInput`: × Position gain.
-    Position,
-    /// An `audioParam`: the raw channel.
-    AudioParam,
-    /// Declared by no element.
-    Unused,
-}
-
-/// A model ready to run: compiled for one sample rate, with its scratch buffers.
-#[derive(Debug)]
-pub struct Prepared {
-    pub engine: Engine,
-    pub sample_rate: f64,
-    pub name: String,
-    pub settings: HostSettings,
-    /// Planar input scratch, `roles.len()` channels of [`CHUNK`] samples.
-    pub inputs: Vec<f64>,
-    /// Planar output scratch, `max(outputs, 1)` channels of [`CHUNK`] samples.
-    pub outputs: Vec<f64>,
-    pub num_outputs: usize,
-    /// One entry per model input channel (`@in1` first).
-    pub roles: Vec<InputRole>,
-    /// The host channel feeding each model input, when the script chose one.
-    pub routing: Vec<Option<RouteSource>>,
-    /// The declared position of each position input's avatar (0 for other inputs): a
-    /// `posInput` receives rest + signal × Position gain.
-    pub rest: Vec<f64>,
-    /// The model input a MIDI note strikes (0-based), if it exists.
-    pub note_input: Option<usize>,
-    /// Force inputs are read "as at 44.1 kHz", like the script's parameters: a force signal
-    /// is scaled by (44100/SR)², the class of gravity (spec §1.7), so a sidechain moves the
-    /// model the same at any sample rate. 1 in `~samplerate raw` scripts.
-    pub force_scale: f64,
-    /// A one-sample strike (MIDI note, editor) is scaled by 44100/SR so that it gives the
-    /// model the same momentum at any sample rate. 1 in `~samplerate raw` scripts.
-    pub strike_scale: f64,
-    pub macros: Vec<Option<MacroBinding>>,
-    pub envelope: StabilityEnvelope,
-    /// Per macro slot: the envelopes with its param at the range's minimum and maximum (the
-    /// others at their declared values).
-    pub macro_envelopes: Vec<Option<(StabilityEnvelope, StabilityEnvelope)>>,
-    /// Loads at unit gains: (worst load, label of the worst mass or structure).
-    pub worst_load: (f64, String),
-    /// Publishes the positions for the editor.
-    pub motion: MotionWriter,
-    /// The editor's end of `motion`, until the store takes it.
-    pub motion_reader: Option<MotionReader>,
+/// Prepares a script for the instrument ([`instrument::prepare`]) with a motion channel for
+/// the editor: the model publishes its positions, the reader goes to the editor.
+pub fn prepare(
+    name: &str,
+    text: &str,
+    sample_rate: f64,
+) -> Result<(Prepared, MotionReader), Rejected> {
+    let mut prepared = instrument::prepare(name, text, sample_rate)?;
+    let (writer, reader) = motion_channel(&prepared.engine, sample_rate);
+    prepared.watcher = Some(Box::new(writer));
+    Ok((prepared, reader))
 }
 
 /// A model's description for the editor and the tests: counts and analysis, made when it
@@ -124,314 +72,60 @@ pub struct ModelStatus {
     pub rejected: Option<ModelState>,
 }
 
-/// Why a script did not become the running model.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Rejected(pub Vec<String>);
-
-impl std::fmt::Display for Rejected {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0.join("\n"))
-    }
-}
-
-/// Parses a script and turns every error into a `LINE:COL: error: …` line. Warnings are kept
-/// too, after the errors, when the script is accepted.
-pub fn parse_script(text: &str) -> Result<(ModelSpec, HostSettings, Vec<String>), Rejected> {
-    let parsed = parse(text);
-    let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
-    if !errors.is_empty() {
-        return Err(Rejected(errors));
-    }
-    let warnings: Vec<String> = parsed.diagnostics.iter().map(|d| d.to_string()).collect();
-    let Some(spec) = parsed.spec else {
-        return Err(Rejected(vec![
-            "1:1: error: the script describes no model".into()
-        ]));
-    };
-    let settings = HostSettings::from_spec(&spec).map_err(Rejected)?;
-    Ok((spec, settings, warnings))
-}
-
-/// Compiles a script for a sample rate and derives everything the audio thread needs.
-pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rejected> {
-    let (spec, settings, _warnings) = parse_script(text)?;
-    let mut engine = compile(&spec, &CompileOptions::at(sample_rate))
-        .map_err(|e| Rejected(e.0.iter().map(|e| format!("1:1: error: {e}")).collect()))?;
-    let info = engine.info().clone();
-
-    let roles: Vec<InputRole> = info
+/// The editor's description of a model.
+pub fn summary(prepared: &mut Prepared) -> ModelSummary {
+    let info = prepared.engine.info();
+    let inputs = info
         .inputs
-        .iter()
-        .map(|uses| match uses.first() {
-            Some(InputUse::Force(_)) => InputRole::Force,
-            Some(InputUse::Position(_)) => InputRole::Position,
-            Some(InputUse::Param(_)) => InputRole::AudioParam,
-            None => InputRole::Unused,
-        })
-        .collect();
-    // Avatars rest at their declared position: a silent input holds them there.
-    let rest: Vec<f64> = info
-        .inputs
-        .iter()
-        .map(|uses| match uses.first() {
-            Some(InputUse::Position(label)) => (0..info.num_points)
-                .find(|&i| info.point_label(i) == *label)
-                .map(|i| engine.positions()[i])
-                .unwrap_or(0.0),
-            _ => 0.0,
-        })
-        .collect();
-    if let Some(k) = settings.note_input {
-        if roles.get(k as usize) != Some(&InputRole::Force) {
-            let line = text
-                .lines()
-                .position(|l| l.trim_start().starts_with("~note"))
-                .map(|i| i + 1)
-                .unwrap_or(1);
-            return Err(Rejected(vec![format!(
-                "{line}:1: error: `~note in{}`: in{} is not a force input (frcInput) of this model",
-                k + 1,
-                k + 1
-            )]));
-        }
-    }
-    let routing = (0..roles.len())
-        .map(|i| settings.routing.get(i).copied().flatten())
-        .collect();
-    let note_input = settings
-        .note_input
-        .map(|i| i as usize)
-        .or_else(|| roles.iter().position(|r| *r == InputRole::Force));
-
-    let mut settings = settings;
-    if settings.reference_pitch_hz.is_none() {
-        settings.reference_pitch_hz = estimate_pitch(&mut engine, note_input, &roles);
-    }
-    let envelope = envelope(&mut engine);
-    let report = engine.stability();
-    let worst_load = worst_load(&report);
-    let macros = macro_bindings(&mut engine, &settings);
-    let macro_envelopes = macros
-        .iter()
-        .map(|b| {
-            b.as_ref().map(|b| {
-                let _ = engine.set_param(b.param, b.min);
-                let low = raw_envelope(&mut engine);
-                let _ = engine.set_param(b.param, b.max);
-                let high = raw_envelope(&mut engine);
-                let _ = engine.set_param(b.param, b.default);
-                engine.apply_pending_changes();
-                (low.scaled(envelope.scale), high.scaled(envelope.scale))
-            })
-        })
-        .collect();
-
-    let rate = match spec.sample_rate_mode {
-        SampleRateMode::Scaled => REFERENCE_SAMPLE_RATE_HZ / sample_rate,
-        SampleRateMode::Raw => 1.0,
-    };
-    let num_outputs = info.num_outputs();
-    let (motion, motion_reader) = motion_channel(&engine, sample_rate);
-    Ok(Prepared {
-        motion,
-        motion_reader: Some(motion_reader),
-        inputs: vec![0.0; roles.len() * CHUNK],
-        outputs: vec![0.0; num_outputs.max(1) * CHUNK],
-        num_outputs,
-        roles,
-        routing,
-        rest,
-        note_input,
-        force_scale: rate * rate,
-        strike_scale: rate,
-        macros,
-        envelope,
-        macro_envelopes,
-        worst_load,
-        settings,
-        sample_rate,
-        name: name.to_string(),
-        engine,
-    })
-}
-
-/// Work budget of the pitch estimate, in element-steps: small models get a long window,
-/// models too large for it get none (the tuning law then uses its low-frequency limit).
-const PITCH_BUDGET: f64 = 4e7;
-/// Length of the pitch estimate's impulse response.
-const PITCH_WINDOW: usize = 8192;
-
-/// The model's reference pitch: the strongest spectral peak of `@out1` after a force impulse
-/// on the note input, found by rendering [`PITCH_WINDOW`] samples off the audio thread. The
-/// engine is reset afterwards. None when the model has no force input or output, is too large
-/// for the budget, or does not ring.
-fn estimate_pitch(
-    engine: &mut Engine,
-    note_input: Option<usize>,
-    roles: &[InputRole],
-) -> Option<f64> {
-    let k = note_input?;
-    let info = engine.info();
-    if info.num_outputs() == 0 {
-        return None;
-    }
-    let size = (info.num_points + info.num_interactions).max(1) as f64;
-    if size * PITCH_WINDOW as f64 > PITCH_BUDGET {
-        return None;
-    }
-    let sr = engine.sample_rate_hz();
-    let n_in = roles.len();
-    let n_out = info.num_outputs();
-    let mut inputs = vec![0.0; n_in * CHUNK];
-    let mut outputs = vec![0.0; n_out * CHUNK];
-    let mut signal = Vec::with_capacity(PITCH_WINDOW);
-    inputs[k * CHUNK] = -1e-3;
-    while signal.len() < PITCH_WINDOW {
-        engine.process(CHUNK, &inputs, &mut outputs);
-        inputs.fill(0.0);
-        signal.extend_from_slice(&outputs[..CHUNK]);
-    }
-    let tripped = engine.is_tripped();
-    engine.reset();
-    if tripped {
-        return None;
-    }
-    peak_frequency(&signal, sr)
-}
-
-/// The frequency of the strongest peak above 20 Hz (Hann window, parabolic interpolation of
-/// the log magnitude).
-pub fn peak_frequency(signal: &[f64], sample_rate: f64) -> Option<f64> {
-    let n = signal.len();
-    let mean = signal.iter().sum::<f64>() / n as f64;
-    let mut frame: Vec<f64> = signal
         .iter()
         .enumerate()
-        .map(|(i, x)| {
-            let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos();
-            (x - mean) * w
+        .map(|(i, uses)| {
+            let what: Vec<String> = uses
+                .iter()
+                .map(|u| match u {
+                    InputUse::Force(t) => format!("force on @{t}"),
+                    InputUse::Position(t) => format!("position of @{t}"),
+                    InputUse::Param(t) => format!("audio parameter {t}"),
+                })
+                .collect();
+            format!("in{}: {}", i + 1, what.join(", "))
         })
         .collect();
-    let fft = realfft::RealFftPlanner::<f64>::new().plan_fft_forward(n);
-    let mut spectrum = fft.make_output_vec();
-    fft.process(&mut frame, &mut spectrum).ok()?;
-    let mags: Vec<f64> = spectrum.iter().map(|c| c.norm()).collect();
-    let lo = ((20.0 * n as f64 / sample_rate).ceil() as usize).max(1);
-    let (mut best, mut best_mag) = (0, 0.0);
-    for (i, &m) in mags.iter().enumerate().take(mags.len() - 1).skip(lo) {
-        if m > best_mag {
-            best = i;
-            best_mag = m;
-        }
+    let outputs = info
+        .outputs
+        .iter()
+        .enumerate()
+        .map(|(i, o)| match o {
+            ressort_engine::OutputUse::Position(t) => format!("out{}: position of @{t}", i + 1),
+            ressort_engine::OutputUse::Force(t) => format!("out{}: force on @{t}", i + 1),
+            ressort_engine::OutputUse::Unused => format!("out{}: unused", i + 1),
+        })
+        .collect();
+    let params = info.params.iter().map(|p| p.name.clone()).collect();
+    let (points, interactions) = (info.num_points, info.num_interactions);
+    let report = prepared.engine.stability();
+    let mut stability: Vec<String> = report.warnings.iter().map(|w| w.to_string()).collect();
+    if let Some(w) = report.worst() {
+        stability.insert(
+            0,
+            format!(
+                "closest to the limit: @{} ({:.1} % of 4M used)",
+                w.label,
+                100.0 * w.load()
+            ),
+        );
     }
-    if !(best_mag > 0.0 && best_mag.is_finite()) {
-        return None;
-    }
-    let (a, b, c) = (
-        mags[best - 1].max(1e-300).ln(),
-        best_mag.ln(),
-        mags[best + 1].max(1e-300).ln(),
-    );
-    let denom = a - 2.0 * b + c;
-    let delta = if denom != 0.0 {
-        0.5 * (a - c) / denom
-    } else {
-        0.0
-    };
-    Some((best as f64 + delta.clamp(-0.5, 0.5)) * sample_rate / n as f64)
-}
-
-impl Prepared {
-    /// Fills the planar input scratch for one chunk of `len` samples from the host channels
-    /// (`host_in`: main left, main right, sidechain left, sidechain right; see
-    /// [`crate::host::channel`]). Each model input takes the channel its `~route` names, else
-    /// the next of `order`; a position input receives its rest + signal × `position`, a force
-    /// input signal × `force` × [`Prepared::force_scale`], an audio-rate parameter the raw
-    /// signal (the engine adds its declared default). An unfed input holds its rest.
-    pub fn fill_inputs(
-        &mut self,
-        host_in: &[[f64; CHUNK]; 4],
-        order: &[RouteSource],
-        len: usize,
-        force: f64,
-        position: f64,
-    ) {
-        for (k, role) in self.roles.iter().enumerate() {
-            let source = self.routing[k].or_else(|| order.get(k).copied());
-            let gain = match role {
-                InputRole::Force => force * self.force_scale,
-                InputRole::Position => position,
-                InputRole::AudioParam => 1.0,
-                InputRole::Unused => 0.0,
-            };
-            let rest = self.rest[k];
-            let dst = &mut self.inputs[k * len..(k + 1) * len];
-            match source.and_then(crate::host::channel) {
-                Some(c) if gain != 0.0 => {
-                    for (d, s) in dst.iter_mut().zip(&host_in[c][..len]) {
-                        *d = rest + s * gain;
-                    }
-                }
-                _ => dst.fill(rest),
-            }
-        }
-    }
-
-    /// The editor's description of this model.
-    pub fn summary(&mut self) -> ModelSummary {
-        let info = self.engine.info();
-        let inputs = info
-            .inputs
-            .iter()
-            .enumerate()
-            .map(|(i, uses)| {
-                let what: Vec<String> = uses
-                    .iter()
-                    .map(|u| match u {
-                        InputUse::Force(t) => format!("force on @{t}"),
-                        InputUse::Position(t) => format!("position of @{t}"),
-                        InputUse::Param(t) => format!("audio parameter {t}"),
-                    })
-                    .collect();
-                format!("in{}: {}", i + 1, what.join(", "))
-            })
-            .collect();
-        let outputs = info
-            .outputs
-            .iter()
-            .enumerate()
-            .map(|(i, o)| match o {
-                ressort_engine::OutputUse::Position(t) => format!("out{}: position of @{t}", i + 1),
-                ressort_engine::OutputUse::Force(t) => format!("out{}: force on @{t}", i + 1),
-                ressort_engine::OutputUse::Unused => format!("out{}: unused", i + 1),
-            })
-            .collect();
-        let params = info.params.iter().map(|p| p.name.clone()).collect();
-        let (points, interactions) = (info.num_points, info.num_interactions);
-        let report = self.engine.stability();
-        let mut stability: Vec<String> = report.warnings.iter().map(|w| w.to_string()).collect();
-        if let Some(w) = report.worst() {
-            stability.insert(
-                0,
-                format!(
-                    "closest to the limit: @{} ({:.1} % of 4M used)",
-                    w.label,
-                    100.0 * w.load()
-                ),
-            );
-        }
-        ModelSummary {
-            name: self.name.clone(),
-            points,
-            interactions,
-            inputs,
-            outputs,
-            params,
-            macros: self.macros.clone(),
-            stability,
-            reference_pitch_hz: self.settings.reference_pitch_hz,
-            reference_key: self.settings.reference_key,
-        }
+    ModelSummary {
+        name: prepared.name.clone(),
+        points,
+        interactions,
+        inputs,
+        outputs,
+        params,
+        macros: prepared.macros.clone(),
+        stability,
+        reference_pitch_hz: prepared.settings.reference_pitch_hz,
+        reference_key: prepared.settings.reference_key,
     }
 }
 
@@ -559,10 +253,10 @@ impl ModelStore {
                 let mut status = lock(&self.status);
                 status.diagnostics.clear();
                 status.rejected = None;
-                if let Some(mut p) = prepared {
-                    status.summary = p.summary();
+                if let Some((mut p, reader)) = prepared {
+                    status.summary = summary(&mut p);
                     drop(status);
-                    *lock(&self.motion) = p.motion_reader.take();
+                    *lock(&self.motion) = Some(reader);
                     self.send(Box::new(p));
                 }
                 *lock(&self.running) = state;
@@ -593,7 +287,7 @@ impl ModelStore {
         self.sample_rate
             .store(sample_rate.to_bits(), Ordering::Release);
         let state = self.running();
-        let mut prepared = match prepare(&state.name, &state.script, sample_rate) {
+        let (mut prepared, reader) = match prepare(&state.name, &state.script, sample_rate) {
             Ok(p) => p,
             Err(rejected) => {
                 let preset = crate::presets::Preset::default_preset();
@@ -609,8 +303,8 @@ impl ModelStore {
                 fallback
             }
         };
-        lock(&self.status).summary = prepared.summary();
-        *lock(&self.motion) = prepared.motion_reader.take();
+        lock(&self.status).summary = summary(&mut prepared);
+        *lock(&self.motion) = Some(reader);
         Some(Box::new(prepared))
     }
 

@@ -194,6 +194,12 @@ impl std::fmt::Debug for MotionWriter {
     }
 }
 
+impl ressort_engine::instrument::Watcher for MotionWriter {
+    fn tick(&mut self, frames: usize, positions: &[f64], watching: bool) {
+        MotionWriter::tick(self, frames, positions, watching);
+    }
+}
+
 impl MotionWriter {
     /// Called after every chunk of `frames` samples. When the editor is open and a frame is
     /// due, copies the material points' positions and publishes them. Realtime-safe.

@@ -6,6 +6,7 @@ use crate::param_text::{
     parse_switch,
 };
 use nice_plug::prelude::*;
+use ressort_engine::instrument::Controls;
 use std::sync::Arc;
 
 /// Stiffness and Damping are stored in octaves (log₂ of the factor): the knob is logarithmic
@@ -87,6 +88,21 @@ fn gain_param(name: &'static str, default_db: f32, min_db: f32, max_db: f32) -> 
 }
 
 impl RessortParams {
+    /// The parameters' current values as the instrument's controls.
+    pub fn controls(&self) -> Controls {
+        Controls {
+            stiffness_octaves: self.stiffness.value() as f64,
+            damping_octaves: self.damping.value() as f64,
+            tune_st: self.tune.value() as f64,
+            output_db: self.output_gain.value() as f64,
+            force_db: self.force_gain.value() as f64,
+            position_db: self.position_gain.value() as f64,
+            macros: std::array::from_fn(|i| self.macros[i].value.value() as f64),
+            dc_filter: self.dc_filter.value(),
+            ..Controls::DEFAULT
+        }
+    }
+
     pub fn new(model: Arc<ModelStore>) -> RessortParams {
         let macros = std::array::from_fn(|slot| {
             let store = model.clone();

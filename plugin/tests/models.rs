@@ -2,8 +2,9 @@
 //! stability clamp holds exploding gains back, macro slots bind and map, and a bad script
 //! never replaces the running model.
 
+use ressort_engine::instrument::{prepare, CHUNK, STABILITY_HEADROOM};
 use ressort_engine::ScaleClass;
-use ressort_plugin::model::{prepare, ModelState, ModelStore, CHUNK, STABILITY_HEADROOM};
+use ressort_plugin::model::{ModelState, ModelStore};
 use ressort_plugin::presets::{Preset, PRESETS};
 
 #[test]

@@ -1,7 +1,7 @@
 //! What a script tells the plugin beyond the physics: input routing, the MIDI note target,
 //! the reference pitch and key, and macro ranges.
 
-use ressort_engine::{MacroRange, ModelSpec, RouteSource};
+use crate::{MacroRange, ModelSpec, RouteSource};
 
 /// The default order: `@in1`, `@in2`… take the main input's left and right channels when
 /// the plugin has a main input (effect layout), then the sidechain's.

@@ -1,7 +1,7 @@
 //! The stability envelope: how far the host's Stiffness and Damping gains may go before the
 //! model's coupled (Gershgorin) loads reach the limit of spec §5.2.
 
-use ressort_engine::{Engine, ScaleClass};
+use crate::{Engine, ScaleClass};
 
 /// Stability budget kept free by the Stiffness/Damping clamp: the loads of every mass and
 /// uniform structure stay below this fraction of the limit.
@@ -124,7 +124,7 @@ impl StabilityEnvelope {
 }
 
 /// The highest coupled load of the model and the mass that has it.
-pub fn worst_load(report: &ressort_engine::StabilityReport) -> (f64, String) {
+pub fn worst_load(report: &crate::StabilityReport) -> (f64, String) {
     report
         .masses
         .iter()
@@ -157,7 +157,7 @@ pub fn envelope(engine: &mut Engine) -> StabilityEnvelope {
 
 /// The envelope of the model's current parameter values, unscaled.
 pub fn raw_envelope(engine: &mut Engine) -> StabilityEnvelope {
-    let coupled = |r: &ressort_engine::StabilityReport| -> Vec<f64> {
+    let coupled = |r: &crate::StabilityReport| -> Vec<f64> {
         r.masses.iter().map(|m| m.coupled_load()).collect()
     };
     engine.set_class_gain(ScaleClass::Damping, 0.0);

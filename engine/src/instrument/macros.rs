@@ -1,10 +1,10 @@
 //! Macro slots: the model's `param`s and `audioParam`s bound to the generic host parameters,
 //! with ranges the stability analysis accepts.
 
-use crate::envelope::{worst_load, STABILITY_HEADROOM};
-use crate::host::HostSettings;
-use crate::model::NUM_MACROS;
-use ressort_engine::{Engine, ParamId};
+use super::envelope::{worst_load, STABILITY_HEADROOM};
+use super::host::HostSettings;
+use super::NUM_MACROS;
+use crate::{Engine, ParamId};
 
 /// A macro slot bound to one of the model's `param`s or `audioParam`s. For an `audioParam`
 /// the slot sets its default, the centre its input modulates around.

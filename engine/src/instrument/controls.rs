@@ -1,0 +1,205 @@
+//! The control stage: the host's knobs (Stiffness, Damping, Tune, the gains, the macro slots)
+//! smoothed once per chunk and applied to the running model through its stability clamp.
+//!
+//! Stiffness and Damping multiply every K-class and Z-class argument (spec §1.7's classes);
+//! Tune and the note move the Stiffness gain by the exact discrete tuning law
+//! sin²(πf/SR) = K/4M (spec §5.3), see [`tuning_gain`].
+
+use super::dsp::{db_to_gain, tuning_gain, ChunkSmoother};
+use super::prepare::Prepared;
+use super::{CHUNK, NUM_MACROS};
+use crate::ScaleClass;
+
+/// Smoothing time constant of the physical controls.
+const CONTROL_SMOOTHING_MS: f64 = 15.0;
+/// Smoothing time constant of the gains.
+const GAIN_SMOOTHING_MS: f64 = 5.0;
+/// The Stiffness gain that Damping can never take away through the stability clamp: the
+/// model's own stiffness.
+const KEPT_STIFFNESS_GAIN: f64 = 1.0;
+
+/// The instrument's knobs, in the units the plugin's parameters store.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Controls {
+    /// log₂ of the Stiffness factor.
+    pub stiffness_octaves: f64,
+    /// log₂ of the Damping factor.
+    pub damping_octaves: f64,
+    /// Semitones, by the exact law.
+    pub tune_st: f64,
+    pub output_db: f64,
+    pub force_db: f64,
+    pub position_db: f64,
+    /// Macro slot positions, 0 … 1 (0.5: the declared value).
+    pub macros: [f64; NUM_MACROS],
+    /// The 40 Hz high-pass of the mi-gen example patches.
+    pub dc_filter: bool,
+    /// Semitones of a full pitch bend, up or down.
+    pub bend_range_st: f64,
+    /// A note's strike is velocity^exponent (1: linear; above 1 soft notes are softer).
+    pub velocity_exponent: f64,
+}
+
+impl Controls {
+    /// What a fresh plugin instance starts with.
+    pub const DEFAULT: Controls = Controls {
+        stiffness_octaves: 0.0,
+        damping_octaves: 0.0,
+        tune_st: 0.0,
+        output_db: 24.0,
+        force_db: 0.0,
+        position_db: 0.0,
+        macros: [0.5; NUM_MACROS],
+        dc_filter: true,
+        bend_range_st: 2.0,
+        velocity_exponent: 1.0,
+    };
+
+    /// The smoothed controls as numbers, to notice automation between blocks. Non-finite
+    /// values read as their defaults, so a bad host value never reaches the model.
+    pub(super) fn sanitized(mut self) -> Controls {
+        let d = Controls::DEFAULT;
+        let fix = |v: &mut f64, default: f64| {
+            if !v.is_finite() {
+                *v = default;
+            }
+        };
+        fix(&mut self.stiffness_octaves, d.stiffness_octaves);
+        fix(&mut self.damping_octaves, d.damping_octaves);
+        fix(&mut self.tune_st, d.tune_st);
+        fix(&mut self.output_db, d.output_db);
+        fix(&mut self.force_db, d.force_db);
+        fix(&mut self.position_db, d.position_db);
+        fix(&mut self.bend_range_st, d.bend_range_st);
+        fix(&mut self.velocity_exponent, d.velocity_exponent);
+        for m in &mut self.macros {
+            fix(m, 0.5);
+        }
+        self
+    }
+}
+
+impl Default for Controls {
+    fn default() -> Self {
+        Controls::DEFAULT
+    }
+}
+
+/// The gains in use after the last chunk, for meters and the editor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gains {
+    /// After the stability clamp.
+    pub stiffness: f64,
+    pub damping: f64,
+    /// Asked for (Stiffness × Tune × note pitch), before the clamp.
+    pub requested_stiffness: f64,
+    pub requested_damping: f64,
+    /// True while the clamp holds a gain below what was asked for.
+    pub clamped: bool,
+}
+
+impl Default for Gains {
+    fn default() -> Self {
+        Gains {
+            stiffness: 1.0,
+            damping: 1.0,
+            requested_stiffness: 1.0,
+            requested_damping: 1.0,
+            clamped: false,
+        }
+    }
+}
+
+/// The smoothed controls, advanced once per chunk.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Smoothed {
+    stiffness: ChunkSmoother,
+    damping: ChunkSmoother,
+    tune: ChunkSmoother,
+    pub force_gain: ChunkSmoother,
+    pub position_gain: ChunkSmoother,
+    pub output_gain: ChunkSmoother,
+    macros: [ChunkSmoother; NUM_MACROS],
+}
+
+impl Smoothed {
+    /// Every smoother on its target: a fresh start.
+    pub fn snapped(c: &Controls, sample_rate: f64) -> Smoothed {
+        let control = |v| ChunkSmoother::new(sample_rate, CHUNK, CONTROL_SMOOTHING_MS, v);
+        let gain = |db| ChunkSmoother::new(sample_rate, CHUNK, GAIN_SMOOTHING_MS, db_to_gain(db));
+        Smoothed {
+            stiffness: control(c.stiffness_octaves),
+            damping: control(c.damping_octaves),
+            tune: control(c.tune_st),
+            force_gain: gain(c.force_db),
+            position_gain: gain(c.position_db),
+            output_gain: gain(c.output_db),
+            macros: c.macros.map(control),
+        }
+    }
+
+    /// Advances every smoother by `n` samples towards `c`; `bend_st` joins Tune.
+    pub fn advance(&mut self, n: usize, c: &Controls, bend_st: f64) {
+        self.stiffness.advance(n, c.stiffness_octaves);
+        self.damping.advance(n, c.damping_octaves);
+        self.tune.advance(n, c.tune_st + bend_st);
+        self.force_gain.advance(n, db_to_gain(c.force_db));
+        self.position_gain.advance(n, db_to_gain(c.position_db));
+        self.output_gain.advance(n, db_to_gain(c.output_db));
+        for (s, &m) in self.macros.iter_mut().zip(&c.macros) {
+            s.advance(n, m);
+        }
+    }
+
+    /// Applies the smoothed gains and macros to `model`, clamped by its stability envelope
+    /// and the macro envelopes of the slots that moved. `note_st` is the note's distance
+    /// from the reference key in semitones.
+    pub fn apply(&self, model: &mut Prepared, note_st: f64) -> Gains {
+        let semitones = self.tune.value + note_st;
+        let tuning = tuning_gain(
+            semitones,
+            model.settings.reference_pitch_hz,
+            model.sample_rate,
+        );
+        let requested_k = 2f64.powf(self.stiffness.value) * tuning;
+        let requested_z = 2f64.powf(self.damping.value);
+        let mut moved = [(&model.envelope, 0.0); NUM_MACROS];
+        let mut n_moved = 0;
+        for (slot, (binding, envs)) in model.macros.iter().zip(&model.macro_envelopes).enumerate() {
+            if let (Some(b), Some((low, high))) = (binding, envs) {
+                let v = b.value_at(self.macros[slot].value);
+                let (env, f) = if v > b.default && b.max > b.default {
+                    (high, (v - b.default) / (b.max - b.default))
+                } else if v < b.default && b.min < b.default {
+                    (low, (b.default - v) / (b.default - b.min))
+                } else {
+                    continue;
+                };
+                moved[n_moved] = (env, f.clamp(0.0, 1.0));
+                n_moved += 1;
+            }
+        }
+        let (gk, gz, clamped) = model.envelope.clamp_moved(
+            requested_k,
+            requested_z,
+            KEPT_STIFFNESS_GAIN,
+            &moved[..n_moved],
+        );
+        model.engine.set_class_gain(ScaleClass::Stiffness, gk);
+        model.engine.set_class_gain(ScaleClass::Damping, gz);
+        for (slot, binding) in model.macros.iter().enumerate() {
+            if let Some(b) = binding {
+                let _ = model
+                    .engine
+                    .set_param(b.param, b.value_at(self.macros[slot].value));
+            }
+        }
+        Gains {
+            stiffness: gk,
+            damping: gz,
+            requested_stiffness: requested_k,
+            requested_damping: requested_z,
+            clamped,
+        }
+    }
+}

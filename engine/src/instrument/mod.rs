@@ -1,0 +1,427 @@
+//! # The instrument: a compiled model played like a synthesizer
+//!
+//! What the plugin and `ressort render --as-plugin` both run, so that the command line
+//! produces what a host hears. The pipeline of the crate continues here: text → spec →
+//! compiled model ([`prepare`], off the audio thread) → [`Instrument::process`], a short
+//! sequence of stages per span of samples:
+//!
+//! 1. **host inputs** ([`Prepared::fill_inputs`]): host channels → model inputs, with the
+//!    Force and Position gains and the script's `~route`s;
+//! 2. **events** ([`events`]): notes retune the model at their own sample (a new control
+//!    chunk starts there) and strike its note input; pitch bend joins Tune;
+//! 3. **controls** ([`controls`]): knobs smoothed per chunk and applied through the
+//!    stability clamp;
+//! 4. **the model** (and the one it replaces, during a 20 ms crossfade);
+//! 5. **output stage** ([`output`]): gain ramp, DC filter, guard fade, soft ceiling, flush to
+//!    zero.
+//!
+//! Control changes act on a grid of [`CHUNK`] samples counted from the start, so a render
+//! does not depend on how a host cuts its blocks; automation (a [`Instrument::process`] call
+//! whose controls differ from the previous one's) and notes start a chunk at their own
+//! sample. Nothing here allocates, locks or does I/O after [`Instrument::new`].
+
+pub mod controls;
+pub mod dsp;
+pub mod envelope;
+pub mod events;
+pub mod host;
+pub mod macros;
+pub mod output;
+pub mod prepare;
+
+pub use controls::{Controls, Gains};
+pub use envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
+pub use events::{Event, Timed};
+pub use host::HostSettings;
+pub use macros::MacroBinding;
+pub use prepare::{parse_script, peak_frequency, prepare, InputRole, Prepared, Rejected, Watcher};
+
+use crate::RouteSource;
+use controls::Smoothed;
+use output::{OutputStage, Span};
+
+/// The engine runs in chunks of at most this many samples; gains and macros are updated at
+/// chunk boundaries (counted from activation, so results do not depend on the host's block
+/// size).
+pub const CHUNK: usize = 16;
+
+/// The number of generic macro slots.
+pub const NUM_MACROS: usize = 16;
+
+/// Host input channels the instrument reads: main left and right, then up to eight sidechain
+/// channels ([`host::channel`]).
+pub const MAX_HOST_INPUTS: usize = 10;
+
+/// Host output channels the instrument writes: main left and right (`@out1`, `@out2`), then
+/// `@out3` … `@out8` on auxiliary outputs.
+pub const MAX_HOST_OUTPUTS: usize = 8;
+
+/// Length of the crossfade from a replaced model to the new one.
+pub const SWAP_FADE_MS: f64 = 20.0;
+
+/// What one [`Instrument::process`] call did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BlockReport {
+    /// How many times the guard reset the model (non-finite output or an engine trip), at
+    /// most once per span.
+    pub trips: u32,
+    /// The loudest host input or output sample, to decide when the host may sleep.
+    pub loudest: f64,
+    /// A model crossfade is still running.
+    pub fading: bool,
+}
+
+/// A model played by notes, knobs and host audio. See the module documentation.
+#[derive(Debug)]
+pub struct Instrument {
+    sample_rate: f64,
+    current: Option<Box<Prepared>>,
+    /// The model being faded out, and the samples left of the fade.
+    outgoing: Option<Box<Prepared>>,
+    fade_left: usize,
+    fade_len: usize,
+    /// A model whose fade ended, waiting for [`Instrument::take_retired`].
+    retired: Option<Box<Prepared>>,
+    controls: Controls,
+    smoothed: Smoothed,
+    gains: Gains,
+    /// Output gain where the current chunk's per-sample ramp starts.
+    last_output_gain: f64,
+    /// Length of the current chunk and the samples of it already rendered. A chunk runs to
+    /// the next multiple of CHUNK (counted from the start), so the sound does not depend on
+    /// the host's block size; automation and notes start a new chunk at their own sample.
+    chunk_len: usize,
+    chunk_done: usize,
+    /// Samples since the start: chunk boundaries are multiples of CHUNK.
+    counter: u64,
+    output: OutputStage,
+    /// Semitones from the reference key of the last note, and the pitch bend.
+    note_st: f64,
+    bend_st: f64,
+    /// The default host channel order for model inputs without a `~route`.
+    order: &'static [RouteSource],
+    /// Whether the model's watcher should publish (an open editor).
+    watching: bool,
+    host_in: [[f64; CHUNK]; MAX_HOST_INPUTS],
+}
+
+impl Instrument {
+    /// An instrument at `sample_rate` with `controls` in place, playing nothing until
+    /// [`Instrument::set_model`].
+    pub fn new(sample_rate: f64, controls: Controls) -> Instrument {
+        let controls = controls.sanitized();
+        let smoothed = Smoothed::snapped(&controls, sample_rate);
+        Instrument {
+            sample_rate,
+            current: None,
+            outgoing: None,
+            fade_left: 0,
+            fade_len: 1,
+            retired: None,
+            controls,
+            last_output_gain: smoothed.output_gain.value,
+            smoothed,
+            gains: Gains::default(),
+            chunk_len: 0,
+            chunk_done: 0,
+            counter: 0,
+            output: OutputStage::new(sample_rate),
+            note_st: 0.0,
+            bend_st: 0.0,
+            order: host::default_order(false),
+            watching: false,
+            host_in: [[0.0; CHUNK]; MAX_HOST_INPUTS],
+        }
+    }
+
+    pub fn sample_rate(&self) -> f64 {
+        self.sample_rate
+    }
+
+    /// Whether the host feeds a main input: model inputs without a `~route` then take main
+    /// left and right first (the effect layouts), else the sidechain's channels.
+    pub fn set_main_input(&mut self, present: bool) {
+        self.order = host::default_order(present);
+    }
+
+    /// Whether someone watches the model's motion (the editor is open).
+    pub fn set_watching(&mut self, watching: bool) {
+        self.watching = watching;
+    }
+
+    /// The running model.
+    pub fn model(&self) -> Option<&Prepared> {
+        self.current.as_deref()
+    }
+
+    pub fn model_mut(&mut self) -> Option<&mut Prepared> {
+        self.current.as_deref_mut()
+    }
+
+    /// The gains in use after the last chunk.
+    pub fn gains(&self) -> Gains {
+        self.gains
+    }
+
+    /// Plays `model` from now on, crossfading from the running one over [`SWAP_FADE_MS`]
+    /// (at once when nothing ran). Returns a model to free off the audio thread: the one
+    /// that was still fading out. Realtime-safe.
+    pub fn set_model(&mut self, model: Box<Prepared>) -> Option<Box<Prepared>> {
+        let stale = self.outgoing.take();
+        self.outgoing = self.current.replace(model);
+        self.fade_len = ((SWAP_FADE_MS * 1e-3 * self.sample_rate) as usize).max(1);
+        self.fade_left = if self.outgoing.is_some() {
+            self.fade_len
+        } else {
+            0
+        };
+        // The new model's gains and macros are set before its first sample.
+        self.apply();
+        stale
+    }
+
+    /// Takes every model out, for a host that deactivates.
+    pub fn take_models(&mut self) -> [Option<Box<Prepared>>; 3] {
+        [
+            self.current.take(),
+            self.outgoing.take(),
+            self.retired.take(),
+        ]
+    }
+
+    /// A model whose crossfade has ended, to free off the audio thread.
+    pub fn take_retired(&mut self) -> Option<Box<Prepared>> {
+        self.retired.take()
+    }
+
+    /// A fresh start: the model at rest, no fade, no note or bend, every smoother on
+    /// `controls`, the chunk grid from 0. Returns the model that was fading out.
+    pub fn reset(&mut self, controls: Controls) -> Option<Box<Prepared>> {
+        if let Some(m) = self.current.as_mut() {
+            m.engine.reset();
+        }
+        self.fade_left = 0;
+        self.note_st = 0.0;
+        self.bend_st = 0.0;
+        self.controls = controls.sanitized();
+        self.smoothed = Smoothed::snapped(&self.controls, self.sample_rate);
+        self.last_output_gain = self.smoothed.output_gain.value;
+        self.output = OutputStage::new(self.sample_rate);
+        self.counter = 0;
+        self.chunk_len = 0;
+        self.chunk_done = 0;
+        self.apply();
+        self.outgoing.take()
+    }
+
+    /// Puts the model back at rest and fades the output back in (the guard, the editor's
+    /// reset).
+    pub fn restart(&mut self) {
+        if let Some(m) = self.current.as_mut() {
+            m.engine.reset();
+        }
+        self.output.restart(self.sample_rate);
+    }
+
+    /// Applies the smoothed controls to the running model.
+    fn apply(&mut self) {
+        if let Some(m) = self.current.as_deref_mut() {
+            self.gains = self.smoothed.apply(m, self.note_st);
+        }
+    }
+
+    /// Starts a control chunk at the current sample: it runs to the next grid point. The
+    /// smoothers advance by its length when `advance` (a grid point, or automation); a chunk
+    /// that a note cuts only re-applies them with the new pitch, since they already stand at
+    /// the grid point both chunks run to.
+    fn start_chunk(&mut self, advance: bool) {
+        // The next ramp starts where this one got to: its end, or where a cut left it.
+        let g1 = self.smoothed.output_gain.value;
+        if self.chunk_done >= self.chunk_len {
+            self.last_output_gain = g1;
+        } else {
+            self.last_output_gain +=
+                (g1 - self.last_output_gain) * self.chunk_done as f64 / self.chunk_len as f64;
+        }
+        self.chunk_len = CHUNK - (self.counter % CHUNK as u64) as usize;
+        self.chunk_done = 0;
+        if advance {
+            self.smoothed
+                .advance(self.chunk_len, &self.controls, self.bend_st);
+        }
+        self.apply();
+    }
+
+    /// Renders `frames` samples. `host_in[c]` is host input channel c ([`host::channel`]
+    /// numbering; `None` or short channels read silence, NaN and subnormal samples read 0);
+    /// with `main_in_place`, channels 0 and 1 are read from `out[0]` and `out[1]` instead, a
+    /// host's in-place main bus (each span's input is read before its output is written);
+    /// `events` come in time order (`timing` < `frames`; late ones act at once); `out[c]` is
+    /// host output channel c (0, 1: main left and right). `controls` hold for the whole
+    /// call: a host cuts its blocks at automation points.
+    pub fn process(
+        &mut self,
+        frames: usize,
+        host_in: &[Option<&[f32]>],
+        main_in_place: bool,
+        events: &mut impl Iterator<Item = Timed>,
+        controls: &Controls,
+        out: &mut [&mut [f32]],
+    ) -> BlockReport {
+        let controls = controls.sanitized();
+        let mut automated = controls != self.controls;
+        self.controls = controls;
+        let mut report = BlockReport::default();
+        // Events past the block's end act at its last sample.
+        let at = |e: &Timed| (e.timing as usize).min(frames.saturating_sub(1));
+        let mut next = events.next();
+        let mut pos = 0;
+        while pos < frames {
+            // Events up to this sample: notes retune from here, strikes land here.
+            let mut strike = 0.0;
+            let mut retuned = false;
+            while let Some(e) = next.filter(|e| at(e) <= pos) {
+                match e.event {
+                    Event::NoteOn { note, velocity } => {
+                        if let Some(m) = self.current.as_deref() {
+                            self.note_st = note as f64 - m.settings.reference_key;
+                            retuned = true;
+                        }
+                        strike +=
+                            events::velocity_response(velocity, self.controls.velocity_exponent);
+                    }
+                    Event::Strike { velocity } => {
+                        strike += events::velocity_response(velocity, 1.0);
+                    }
+                    Event::PitchBend { value } => {
+                        self.bend_st = events::bend_semitones(value, self.controls.bend_range_st);
+                    }
+                    Event::NoteOff { .. } => {}
+                }
+                next = events.next();
+            }
+            if automated || self.chunk_done >= self.chunk_len {
+                automated = false;
+                self.start_chunk(true);
+            } else if retuned {
+                self.start_chunk(false);
+            }
+            let mut len = (self.chunk_len - self.chunk_done).min(frames - pos);
+            if let Some(e) = next.as_ref() {
+                // The span ends at the next event, which then acts at its own sample.
+                len = len.min(at(e).saturating_sub(pos).max(1));
+            }
+            if self.span(pos, len, (host_in, main_in_place), strike, out, &mut report) {
+                report.trips += 1;
+                self.restart();
+            }
+            pos += len;
+            self.counter += len as u64;
+            self.chunk_done += len;
+        }
+        // A call of zero frames: its events change the pitch state only.
+        while let Some(e) = next {
+            match e.event {
+                Event::PitchBend { value } => {
+                    self.bend_st = events::bend_semitones(value, self.controls.bend_range_st);
+                }
+                Event::NoteOn { note, .. } => {
+                    if let Some(m) = self.current.as_deref() {
+                        self.note_st = note as f64 - m.settings.reference_key;
+                    }
+                }
+                _ => {}
+            }
+            next = events.next();
+        }
+        report.fading = self.fade_left > 0;
+        report
+    }
+
+    /// One span of `len` samples at `pos` within one chunk: inputs, the models, the output
+    /// stage. Returns whether the guard tripped.
+    fn span(
+        &mut self,
+        pos: usize,
+        len: usize,
+        (host_in, main_in_place): (&[Option<&[f32]>], bool),
+        strike: f64,
+        out: &mut [&mut [f32]],
+        report: &mut BlockReport,
+    ) -> bool {
+        // Host inputs.
+        for (c, row) in self.host_in.iter_mut().enumerate() {
+            let src: Option<&[f32]> = if main_in_place && c < 2 {
+                out.get(c).map(|s| &**s)
+            } else {
+                host_in.get(c).copied().flatten()
+            };
+            let src = src.and_then(|s| s.get(pos..)).unwrap_or(&[]);
+            for (i, d) in row[..len].iter_mut().enumerate() {
+                *d = src.get(i).copied().map_or(0.0, dsp::input_sample);
+                report.loudest = report.loudest.max(d.abs());
+            }
+        }
+        let force = self.smoothed.force_gain.value;
+        let position = self.smoothed.position_gain.value;
+        let mut tripped = false;
+        if let Some(m) = self.current.as_deref_mut() {
+            m.fill_inputs(&self.host_in, self.order, len, force, position);
+            if strike > 0.0 {
+                m.strike(0, len, strike, force);
+            }
+            // The model.
+            let n_in = m.roles.len();
+            let n_out = m.outputs.len() / CHUNK;
+            let r = m
+                .engine
+                .process(len, &m.inputs[..n_in * len], &mut m.outputs[..n_out * len]);
+            tripped |= r.tripped;
+            if let Some(w) = m.watcher.as_mut() {
+                w.tick(len, m.engine.positions(), self.watching);
+            }
+        }
+        if let Some(old) = self.outgoing.as_deref_mut() {
+            let n_in = old.roles.len();
+            let n_out = old.outputs.len() / CHUNK;
+            old.inputs[..n_in * len].fill(0.0);
+            old.engine.process(
+                len,
+                &old.inputs[..n_in * len],
+                &mut old.outputs[..n_out * len],
+            );
+        }
+        // Output stage.
+        let span = Span {
+            len,
+            g0: self.last_output_gain,
+            g1: self.smoothed.output_gain.value,
+            done: self.chunk_done,
+            chunk_len: self.chunk_len,
+            dc_on: self.controls.dc_filter,
+            tripped,
+        };
+        let (out_tripped, loudest) = self.output.render(
+            span,
+            self.current.as_deref(),
+            self.outgoing.as_deref(),
+            (&mut self.fade_left, self.fade_len),
+            out,
+            pos,
+        );
+        report.loudest = report.loudest.max(loudest);
+        let tripped = out_tripped;
+        if self.fade_left == 0 {
+            if let Some(old) = self.outgoing.take() {
+                // The plugin takes it after the block; a second one in the same block stays
+                // in `outgoing` until then (it is silent: its fade is over).
+                if self.retired.is_none() {
+                    self.retired = Some(old);
+                } else {
+                    self.outgoing = Some(old);
+                }
+            }
+        }
+        tripped
+    }
+}
