@@ -4,11 +4,15 @@
 //! ressort check MODEL.mdl
 //! ressort render MODEL.mdl -o OUT.wav [--sample-rate HZ] [--samples N | --seconds S]
 //!                [--input inK=FILE.wav]… [--impulse inK=AMPLITUDE]… [--set NAME=VALUE]…
+//! ressort render MODEL.mdl -o OUT.wav --as-plugin [--midi FILE.mid] [--note KEY[:VEL][@S]]…
+//!                [--sidechain FILE.wav] [--main FILE.wav] [--control NAME=VALUE]…
 //! ressort bench MODEL.mdl [--sample-rate HZ] [--seconds S]
 //! ```
 //!
 //! Exit status: 0 for success, 1 when the model has errors, 2 for usage and I/O errors.
 
+mod midi;
+mod play;
 mod report;
 
 use clap::{Args, Parser, Subcommand};
@@ -34,7 +38,7 @@ enum Command {
     /// Parse and compile a model; print its diagnostics, summary and stability report.
     Check(CheckArgs),
     /// Render a model's outputs to a 32-bit float WAV file, one channel per @outN.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Measure a model: parse and compile time, then time per sample with no I/O.
     Bench(BenchArgs),
 }
@@ -74,9 +78,37 @@ struct RenderArgs {
         allow_hyphen_values = true
     )]
     impulses: Vec<String>,
-    /// Set a control parameter before rendering: `K=0.2`.
+    /// Set a control parameter before rendering: `K=0.2`. With `--as-plugin`, a parameter on
+    /// a macro slot moves that slot.
     #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
     sets: Vec<String>,
+    /// Render what the plugin plays: host audio through its gains and routing, notes,
+    /// the stability clamp, output gain, DC filter and soft ceiling; a stereo file (more
+    /// channels for models with @out3…). Implied by the options below.
+    #[arg(long)]
+    as_plugin: bool,
+    /// Play a standard MIDI file (notes and pitch bend; tempo map honoured). The render
+    /// lasts until 2 s after its last event unless a length is given.
+    #[arg(long, value_name = "FILE.mid")]
+    midi: Option<PathBuf>,
+    /// Play a note: key, velocity 0 … 1 (default 0.8), start in seconds: `60`, `64:0.5@0.25`.
+    #[arg(long = "note", value_name = "KEY[:VEL][@SECONDS]")]
+    notes: Vec<String>,
+    /// Feed the plugin's sidechain (its channels in order; up to 8).
+    #[arg(long, value_name = "FILE.wav")]
+    sidechain: Option<PathBuf>,
+    /// Feed the plugin's main input (the effect layouts; stereo).
+    #[arg(long, value_name = "FILE.wav")]
+    main: Option<PathBuf>,
+    /// Set a plugin control: stiffness=×F, damping=×F, tune=ST, output-gain=DB,
+    /// force-gain=DB, position-gain=DB, dc-filter=on|off, bend-range=ST, velocity-curve=EXP,
+    /// macroN=0…1.
+    #[arg(
+        long = "control",
+        value_name = "NAME=VALUE",
+        allow_hyphen_values = true
+    )]
+    controls: Vec<String>,
 }
 
 #[derive(Args, Debug)]
@@ -99,7 +131,7 @@ enum Failure {
     Usage(String),
 }
 
-fn usage(msg: impl Into<String>) -> Failure {
+pub(crate) fn usage(msg: impl Into<String>) -> Failure {
     Failure::Usage(msg.into())
 }
 
@@ -179,6 +211,25 @@ fn input_assignment<'a>(text: &'a str, engine: &Engine) -> Result<(usize, &'a st
 
 /// Reads the first channel of a WAV file as f64 in [−1, 1] (integers) or as stored (floats).
 fn read_wav(path: &Path, sample_rate: u32) -> Result<Vec<f64>, Failure> {
+    let channels = read_wav_channels(path, sample_rate)?;
+    if channels.len() > 1 {
+        eprintln!(
+            "ressort: note: {} has {} channels; using the first",
+            path.display(),
+            channels.len()
+        );
+    }
+    Ok(channels
+        .into_iter()
+        .next()
+        .unwrap_or_default()
+        .into_iter()
+        .map(f64::from)
+        .collect())
+}
+
+/// Reads every channel of a WAV file, in [−1, 1] (integers) or as stored (floats).
+pub(crate) fn read_wav_channels(path: &Path, sample_rate: u32) -> Result<Vec<Vec<f32>>, Failure> {
     let mut reader = hound::WavReader::open(path)
         .map_err(|e| usage(format!("cannot read {}: {e}", path.display())))?;
     let spec = reader.spec();
@@ -191,37 +242,29 @@ fn read_wav(path: &Path, sample_rate: u32) -> Result<Vec<f64>, Failure> {
             spec.sample_rate
         )));
     }
-    if spec.channels > 1 {
-        eprintln!(
-            "ressort: note: {} has {} channels; using the first",
-            path.display(),
-            spec.channels
-        );
-    }
-    let step = spec.channels.max(1) as usize;
+    let n = spec.channels.max(1) as usize;
     let bad = |e: hound::Error| usage(format!("cannot decode {}: {e}", path.display()));
-    let samples: Vec<f64> = match spec.sample_format {
+    let interleaved: Vec<f32> = match spec.sample_format {
         hound::SampleFormat::Float => reader
             .samples::<f32>()
-            .step_by(step)
-            .map(|s| s.map(f64::from))
             .collect::<Result<_, _>>()
             .map_err(bad)?,
         hound::SampleFormat::Int => {
             let scale = 1.0 / (1u64 << (spec.bits_per_sample.clamp(1, 32) - 1)) as f64;
             reader
                 .samples::<i32>()
-                .step_by(step)
-                .map(|s| s.map(|v| v as f64 * scale))
+                .map(|s| s.map(|v| (v as f64 * scale) as f32))
                 .collect::<Result<_, _>>()
                 .map_err(bad)?
         }
     };
-    Ok(samples)
+    Ok((0..n)
+        .map(|c| interleaved.iter().skip(c).step_by(n).copied().collect())
+        .collect())
 }
 
 /// The maximum length of a render: one hour at 192 kHz.
-const MAX_RENDER_SAMPLES: u64 = 192_000 * 3600;
+pub(crate) const MAX_RENDER_SAMPLES: u64 = 192_000 * 3600;
 const RENDER_BLOCK_FRAMES: usize = 4096;
 
 fn render(a: &RenderArgs) -> Result<(), Failure> {
@@ -241,6 +284,10 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
         return Err(usage(format!(
             "{total} samples is longer than the limit of {MAX_RENDER_SAMPLES} (one hour at 192 kHz)"
         )));
+    }
+    if play::wanted(a) {
+        let given = a.samples.is_some() || a.seconds.is_some();
+        return play::render(a, given.then_some(total));
     }
     let spec = load(&a.model)?;
     let mut engine = build(&a.model, &spec, sr as f64)?;

@@ -1,0 +1,343 @@
+//! `ressort render --as-plugin`: the model played through the instrument that the plugin
+//! runs (`ressort_engine::instrument`), so the WAV file is what a host would record: host
+//! channels through the Force and Position gains, notes retuning and striking, the stability
+//! clamp, the output gain, the DC filter and the soft ceiling.
+
+use crate::{midi, read_wav_channels, usage, Failure, RenderArgs};
+use ressort_engine::instrument::{
+    self, Controls, Event, Instrument, Prepared, Timed, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS,
+};
+
+/// Host block size of the render. The instrument's output does not depend on it.
+const BLOCK: usize = 512;
+/// Ring-out after the last MIDI event when no length is given.
+const TAIL_SECONDS: f64 = 2.0;
+
+/// Whether the arguments ask for the plugin's signal path.
+pub fn wanted(a: &RenderArgs) -> bool {
+    a.as_plugin
+        || a.midi.is_some()
+        || !a.notes.is_empty()
+        || !a.controls.is_empty()
+        || a.sidechain.is_some()
+        || a.main.is_some()
+}
+
+/// Reads `--control NAME=VALUE` into the controls, in the units the plugin shows.
+fn set_control(c: &mut Controls, text: &str) -> Result<(), Failure> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| usage(format!("expected NAME=VALUE, found `{text}`")))?;
+    let number = || -> Result<f64, Failure> {
+        value
+            .trim()
+            .trim_start_matches(['×', 'x'])
+            .trim_end_matches(['×', 'x'])
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                usage(format!(
+                    "`{value}` is not a finite number (in --control {text})"
+                ))
+            })
+    };
+    let factor_octaves = |v: f64| -> Result<f64, Failure> {
+        if v > 0.0 {
+            Ok(v.log2().clamp(-4.0, 4.0))
+        } else {
+            Err(usage(format!(
+                "--control {text}: a factor must be positive (×1/16 … ×16)"
+            )))
+        }
+    };
+    match name.trim() {
+        "stiffness" => c.stiffness_octaves = factor_octaves(number()?)?,
+        "damping" => c.damping_octaves = factor_octaves(number()?)?,
+        "tune" => c.tune_st = number()?.clamp(-24.0, 24.0),
+        "output-gain" => c.output_db = number()?.clamp(-40.0, 60.0),
+        "force-gain" => c.force_db = number()?.clamp(-60.0, 40.0),
+        "position-gain" => c.position_db = number()?.clamp(-60.0, 40.0),
+        "bend-range" => c.bend_range_st = number()?.clamp(0.0, 48.0),
+        "velocity-curve" => c.velocity_exponent = number()?.clamp(0.25, 4.0),
+        "dc-filter" => {
+            c.dc_filter = match value.trim() {
+                "on" | "1" | "true" => true,
+                "off" | "0" | "false" => false,
+                v => return Err(usage(format!("--control dc-filter={v}: use on or off"))),
+            }
+        }
+        n if n.starts_with("macro") => {
+            let slot: usize = n[5..]
+                .parse()
+                .ok()
+                .filter(|s| (1..=instrument::NUM_MACROS).contains(s))
+                .ok_or_else(|| {
+                    usage(format!(
+                        "unknown control `{n}`: macro slots are macro1 … macro{}",
+                        instrument::NUM_MACROS
+                    ))
+                })?;
+            c.macros[slot - 1] = number()?.clamp(0.0, 1.0);
+        }
+        n => {
+            return Err(usage(format!(
+                "unknown control `{n}`; the controls are stiffness, damping, tune, \
+                 output-gain, force-gain, position-gain, dc-filter, bend-range, \
+                 velocity-curve and macro1 … macro{}",
+                instrument::NUM_MACROS
+            )))
+        }
+    }
+    Ok(())
+}
+
+/// `--set NAME=VALUE`: a parameter on a macro slot moves its slot (the plugin would
+/// overwrite the value with the slot's otherwise); any other is set in the model.
+fn set_param(model: &mut Prepared, c: &mut Controls, text: &str) -> Result<(), Failure> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| usage(format!("expected NAME=VALUE, found `{text}`")))?;
+    let v: f64 = value
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite())
+        .ok_or_else(|| {
+            usage(format!(
+                "`{value}` is not a finite number (in --set {text})"
+            ))
+        })?;
+    if let Some((slot, b)) = model
+        .macros
+        .iter()
+        .enumerate()
+        .find_map(|(i, b)| b.as_ref().filter(|b| b.name == name).map(|b| (i, b)))
+    {
+        if v < b.min.min(b.max) || v > b.max.max(b.min) {
+            eprintln!(
+                "ressort: note: --set {text}: Macro {} spans {} … {}; the value is clamped",
+                slot + 1,
+                b.min,
+                b.max
+            );
+        }
+        c.macros[slot] = b.normalized_of(v);
+        return Ok(());
+    }
+    let id = model.engine.param_id(name).ok_or_else(|| {
+        let names: Vec<&str> = model
+            .engine
+            .info()
+            .params
+            .iter()
+            .map(|p| p.name.as_str())
+            .collect();
+        usage(format!(
+            "unknown parameter `{name}`; the model's parameters are: {}",
+            if names.is_empty() {
+                "(none)".to_string()
+            } else {
+                names.join(", ")
+            }
+        ))
+    })?;
+    model
+        .engine
+        .set_param(id, v)
+        .map_err(|e| usage(format!("cannot set `{name}`: {e}")))
+}
+
+/// `--note KEY[:VELOCITY][@SECONDS]`: a note-on (velocity 0 … 1, default 0.8; time default 0).
+fn note(text: &str, sample_rate: f64) -> Result<(u64, Event), Failure> {
+    let bad = || {
+        usage(format!(
+            "--note {text}: expected KEY[:VELOCITY][@SECONDS], e.g. 60, 64:0.5 or 67:1@0.25"
+        ))
+    };
+    let (rest, at) = match text.split_once('@') {
+        Some((r, t)) => (r, t.parse::<f64>().map_err(|_| bad())?),
+        None => (text, 0.0),
+    };
+    let (key, velocity) = match rest.split_once(':') {
+        Some((k, v)) => (k, v.parse::<f32>().map_err(|_| bad())?),
+        None => (rest, 0.8),
+    };
+    let key: u8 = key.parse().ok().filter(|k| *k <= 127).ok_or_else(bad)?;
+    if !(at.is_finite() && at >= 0.0 && velocity.is_finite() && (0.0..=1.0).contains(&velocity)) {
+        return Err(bad());
+    }
+    Ok((
+        (at * sample_rate).round() as u64,
+        Event::NoteOn {
+            note: key,
+            velocity,
+        },
+    ))
+}
+
+/// Renders through the instrument. See the module documentation.
+pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
+    if !a.inputs.is_empty() || !a.impulses.is_empty() {
+        return Err(usage(
+            "--input and --impulse feed model inputs directly; the plugin's signal path takes \
+             host audio (--sidechain FILE.wav, --main FILE.wav) and notes (--note, --midi)",
+        ));
+    }
+    let sr = a.sample_rate;
+    let srf = sr as f64;
+    let text = std::fs::read_to_string(&a.model)
+        .map_err(|e| usage(format!("cannot read {}: {e}", a.model.display())))?;
+    let name = a
+        .model
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut model = match instrument::prepare(&name, &text, srf) {
+        Ok(m) => m,
+        Err(rejected) => {
+            for line in &rejected.0 {
+                eprintln!("{}:{line}", a.model.display());
+            }
+            return Err(Failure::Model);
+        }
+    };
+    let mut controls = Controls::DEFAULT;
+    for c in &a.controls {
+        set_control(&mut controls, c)?;
+    }
+    for s in &a.sets {
+        set_param(&mut model, &mut controls, s)?;
+    }
+
+    let mut events: Vec<(u64, Event)> = Vec::new();
+    for n in &a.notes {
+        events.push(note(n, srf)?);
+    }
+    if let Some(path) = &a.midi {
+        let bytes = std::fs::read(path)
+            .map_err(|e| usage(format!("cannot read {}: {e}", path.display())))?;
+        let file = midi::read_events(&bytes, srf)
+            .map_err(|e| usage(format!("{}: {e}", path.display())))?;
+        events.extend(file);
+    }
+    events.sort_by_key(|e| e.0);
+
+    // Host channels: main left and right, then the sidechain's.
+    let mut host: Vec<Vec<f32>> = vec![Vec::new(); MAX_HOST_INPUTS];
+    let has_main = a.main.is_some();
+    if let Some(path) = &a.main {
+        for (c, ch) in read_wav_channels(path, sr)?.into_iter().take(2).enumerate() {
+            host[c] = ch;
+        }
+    }
+    if let Some(path) = &a.sidechain {
+        let channels = read_wav_channels(path, sr)?;
+        if channels.len() > MAX_HOST_INPUTS - 2 {
+            eprintln!(
+                "ressort: note: {} has {} channels; the plugin reads the first {}",
+                path.display(),
+                channels.len(),
+                MAX_HOST_INPUTS - 2
+            );
+        }
+        for (c, ch) in channels.into_iter().take(MAX_HOST_INPUTS - 2).enumerate() {
+            host[2 + c] = ch;
+        }
+    }
+    let longest_input = host.iter().map(Vec::len).max().unwrap_or(0) as u64;
+    let total = total.unwrap_or_else(|| {
+        let last_event = events.last().map_or(0, |e| e.0);
+        let tail = (TAIL_SECONDS * srf) as u64;
+        (last_event + tail)
+            .max(longest_input)
+            .max(2 * sr as u64)
+            .min(crate::MAX_RENDER_SAMPLES)
+    });
+
+    // Stereo like the plugin's main output; aux pairs for @out3 … when the model has them.
+    let channels = if model.num_outputs <= 2 {
+        2
+    } else {
+        model.num_outputs.min(MAX_HOST_OUTPUTS).div_ceil(2) * 2
+    };
+    let mut inst = Instrument::new(srf, controls);
+    inst.set_main_input(has_main);
+    inst.set_model(Box::new(model));
+
+    let wav_spec = hound::WavSpec {
+        channels: channels as u16,
+        sample_rate: sr,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    let io = |e: hound::Error| usage(format!("cannot write {}: {e}", a.output.display()));
+    let mut writer = hound::WavWriter::create(&a.output, wav_spec).map_err(io)?;
+    let mut out: Vec<Vec<f32>> = vec![vec![0.0; BLOCK]; channels];
+    let mut next_event = 0;
+    let (mut done, mut peak, mut trips) = (0u64, 0.0f32, 0u32);
+    while done < total {
+        let len = BLOCK.min((total - done) as usize);
+        let end = done + len as u64;
+        let first = next_event;
+        while next_event < events.len() && events[next_event].0 < end {
+            next_event += 1;
+        }
+        let mut block_events = events[first..next_event]
+            .iter()
+            .map(|&(t, e)| Timed::new((t.saturating_sub(done)) as u32, e));
+        let start = done as usize;
+        let host_in: Vec<Option<&[f32]>> = host
+            .iter()
+            .map(|ch| ch.get(start..).filter(|s| !s.is_empty()))
+            .collect();
+        if has_main {
+            for (c, o) in out.iter_mut().take(2).enumerate() {
+                let src = host_in[c].unwrap_or(&[]);
+                for (i, s) in o[..len].iter_mut().enumerate() {
+                    *s = src.get(i).copied().unwrap_or(0.0);
+                }
+            }
+        }
+        let mut slices: Vec<&mut [f32]> = out.iter_mut().map(|o| &mut o[..len]).collect();
+        let report = inst.process(
+            len,
+            &host_in,
+            has_main,
+            &mut block_events,
+            &controls,
+            &mut slices,
+        );
+        trips += report.trips;
+        for i in 0..len {
+            for o in &out {
+                peak = peak.max(o[i].abs());
+                writer.write_sample(o[i]).map_err(io)?;
+            }
+        }
+        done = end;
+    }
+    writer.finalize().map_err(io)?;
+    if trips > 0 {
+        eprintln!(
+            "ressort: warning: the guard reset the exploding model {trips} time(s), as the \
+             plugin does; run `ressort check` for its stability report"
+        );
+    }
+    let g = inst.gains();
+    if g.clamped {
+        eprintln!(
+            "ressort: note: the stability clamp held Stiffness at ×{:.3} (asked ×{:.3}) and \
+             Damping at ×{:.3} (asked ×{:.3})",
+            g.stiffness, g.requested_stiffness, g.damping, g.requested_damping
+        );
+    }
+    eprintln!(
+        "wrote {} as the plugin plays it: {} samples at {} Hz, {} channel(s), peak {:.3e}",
+        a.output.display(),
+        total,
+        sr,
+        channels,
+        peak
+    );
+    Ok(())
+}
