@@ -8,8 +8,8 @@
 
 use ressort_tests::state;
 use ressort_tests::{
-    band_energy_share, cents, oscillator_frequency, peak_frequency, run_isolated, Block, ClapId,
-    ProcessStatus, Score, Stereo, TestPlugin,
+    band_energy_share, cents, oscillator_frequency, peak_frequency, plugin_with_model,
+    run_isolated, Block, ClapId, ProcessStatus, Score, Stereo, TestPlugin,
 };
 use serde_json::json;
 
@@ -87,38 +87,6 @@ impl Params {
             macro2: p("Macro 2", 0.0, 1.0),
         }
     }
-}
-
-/// A new instance running `script` (loaded through the plugin state while inactive), with
-/// plain parameter values set in the same state (`(string id, JSON value)`).
-fn plugin_with_model(name: &str, script: &str, params: &[(&str, serde_json::Value)]) -> TestPlugin {
-    let mut plugin = TestPlugin::new();
-    let mut blob = state::with_model(&plugin.save_state(), name, script);
-    for (id, value) in params {
-        blob = state::with_param(&blob, id, value.clone());
-    }
-    plugin
-        .load_state(&blob)
-        .unwrap_or_else(|e| panic!("loading model {name}: {e}"));
-    let saved = plugin.save_state();
-    assert_eq!(
-        state::model(&saved).map(|m| m.1).as_deref(),
-        Some(script),
-        "the plugin did not take model {name}"
-    );
-    // While inactive the plugin only parses a script; it compiles it at activation and runs
-    // the default preset instead when that fails. Activate once so a script that parses but
-    // does not compile fails here, not as a test of the default preset.
-    plugin.activate(48_000.0, 1, 512);
-    let compiled = plugin.save_state();
-    plugin.deactivate();
-    assert_eq!(
-        state::model(&compiled).map(|m| m.1).as_deref(),
-        Some(script),
-        "model {name} parses but does not compile: the plugin fell back to {:?}",
-        state::model(&compiled).map(|m| m.0)
-    );
-    plugin
 }
 
 /// A score of sidechain strikes (left channel) at the given frames.

@@ -1,0 +1,156 @@
+//! The plugin in a CLAP host plays exactly what `ressort_engine::instrument` plays, which is
+//! what `ressort render --as-plugin` runs: one signal path for both (the command line's own
+//! test checks its WAV against the instrument). And a note retunes at its own sample.
+
+use ressort_engine::instrument::{self, Controls, Event, Instrument, Timed, MAX_HOST_INPUTS};
+use ressort_tests::{plugin_with_model, Score, Stereo};
+use serde_json::json;
+
+const SMALL_MESH: &str = include_str!("../models/small-mesh.mdl");
+const LOW_OSCILLATOR: &str = include_str!("../models/low-oscillator.mdl");
+const SR: f64 = 48_000.0;
+
+/// A 14-bit MIDI pitch bend as nice-plug hands it to the plugin (0 … 1).
+fn bend_value(value: f64) -> f32 {
+    let v = ressort_tests::HostEvent::pitch_bend_14bit(value);
+    v as f32 / ((1 << 14) - 1) as f32
+}
+
+/// Renders `frames` through the instrument directly, in blocks of `block`.
+fn instrument_render(
+    script: &str,
+    controls: &Controls,
+    events: &[(u32, Event)],
+    sidechain: &Stereo,
+    frames: usize,
+    block: usize,
+) -> Stereo {
+    let model = instrument::prepare("test", script, SR).expect("the test model prepares");
+    let mut inst = Instrument::new(SR, *controls);
+    inst.set_model(Box::new(model));
+    let mut out = Stereo::silence(frames);
+    let mut start = 0;
+    while start < frames {
+        let n = block.min(frames - start);
+        let mut block_events = events
+            .iter()
+            .filter(|(t, _)| (*t as usize) >= start && (*t as usize) < start + n)
+            .map(|&(t, e)| Timed::new(t - start as u32, e));
+        let mut host_in: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+        host_in[2] = sidechain.left.get(start..start + n);
+        host_in[3] = sidechain.right.get(start..start + n);
+        let (l, r) = (
+            &mut out.left[start..start + n],
+            &mut out.right[start..start + n],
+        );
+        let mut channels: [&mut [f32]; 2] = [l, r];
+        inst.process(
+            n,
+            &host_in,
+            false,
+            &mut block_events,
+            controls,
+            &mut channels,
+        );
+        start += n;
+    }
+    out
+}
+
+#[test]
+fn the_plugin_plays_what_the_instrument_plays() {
+    // Non-default knobs, a macro, notes at odd samples, a bend, and sidechain strikes.
+    let params = [
+        ("stiffness", json!({ "f32": 1.0 })),
+        ("output_gain", json!({ "f32": -6.0 })),
+        ("macro_1", json!({ "f32": 0.7 })),
+    ];
+    let mut plugin = plugin_with_model("small-mesh", SMALL_MESH, &params);
+    let frames = 24_000;
+    let mut sidechain = Stereo::silence(frames);
+    sidechain.left[5_001] = -0.05;
+    sidechain.right[9_777] = -0.03;
+    let score = Score::new()
+        .note_on(101, 60, 0.9)
+        .pitch_bend(2_003, 0.5)
+        .note_on(3_001, 67, 0.5)
+        .note_off(4_000, 60)
+        .note_on(12_345, 55, 1.0)
+        .with_sidechain(sidechain.clone());
+    plugin.activate(SR, 1, 333);
+    let from_plugin = plugin.render_frames(frames, 333, &score).audio;
+
+    let mut controls = Controls::DEFAULT;
+    controls.stiffness_octaves = 1.0;
+    controls.output_db = -6.0;
+    // The plugin stores parameters as f32.
+    controls.macros[0] = 0.7f32 as f64;
+    let events = [
+        (
+            101,
+            Event::NoteOn {
+                note: 60,
+                velocity: 0.9,
+            },
+        ),
+        (
+            2_003,
+            Event::PitchBend {
+                value: bend_value(0.5),
+            },
+        ),
+        (
+            3_001,
+            Event::NoteOn {
+                note: 67,
+                velocity: 0.5,
+            },
+        ),
+        (4_000, Event::NoteOff { note: 60 }),
+        (
+            12_345,
+            Event::NoteOn {
+                note: 55,
+                velocity: 1.0,
+            },
+        ),
+    ];
+    let from_instrument =
+        instrument_render(SMALL_MESH, &controls, &events, &sidechain, frames, 512);
+    println!(
+        "plugin peak {:.4}, instrument peak {:.4}, first difference {:?}",
+        from_plugin.peak(),
+        from_instrument.peak(),
+        from_plugin.first_difference(&from_instrument)
+    );
+    assert!(from_plugin.peak() > 1e-3, "the score must sound");
+    assert!(
+        from_plugin.bit_identical(&from_instrument),
+        "the plugin and the instrument differ from sample {:?}",
+        from_plugin.first_difference(&from_instrument)
+    );
+}
+
+#[test]
+fn a_note_retunes_at_its_own_sample() {
+    // A ringing oscillator; a second note at sample 1003, inside a control chunk. Everything
+    // before it must be exactly what the first note alone plays, and the pitch must change
+    // after it.
+    // Below the soft ceiling, where a change shows in every sample.
+    let gain = [("output_gain", json!({ "f32": -12.0 }))];
+    let mut plugin = plugin_with_model("low-oscillator", LOW_OSCILLATOR, &gain);
+    let frames = 4_800;
+    let one = Score::new().note_on(0, 60, 1.0);
+    let two = Score::new().note_on(0, 60, 1.0).note_on(1_003, 72, 0.0);
+    plugin.activate(SR, 1, 4_800);
+    let a = plugin.render_frames(frames, 4_800, &one).audio;
+    plugin.activate(SR, 1, 4_800);
+    let b = plugin.render_frames(frames, 4_800, &two).audio;
+    let first = a.first_difference(&b);
+    println!("first difference at {first:?} (the note is at 1003)");
+    assert_eq!(
+        first,
+        Some(1_003),
+        "a note must change nothing before its sample and act at it"
+    );
+}
