@@ -615,6 +615,17 @@ impl EditorApp {
         row(ui, "Position in", &|ui| {
             ui.add(ParamSlider::for_param(&p.position_gain, &setter));
         });
+        row(ui, "Bend range", &|ui| {
+            ui.add(ParamSlider::for_param(&p.bend_range, &setter))
+                .on_hover_text("Semitones of a full pitch bend, up or down (MPE uses 48)");
+        });
+        row(ui, "Velocity", &|ui| {
+            ui.add(ParamSlider::for_param(&p.velocity_curve, &setter))
+                .on_hover_text(
+                    "Velocity curve: a note strikes with velocity^this. 1 is linear; above 1 \
+                     soft notes are softer, below 1 louder",
+                );
+        });
         let mut dc = p.dc_filter.value();
         if ui
             .checkbox(&mut dc, "DC filter (40 Hz high-pass)")

@@ -2,8 +2,8 @@
 
 use crate::model::{ModelStore, NUM_MACROS};
 use crate::param_text::{
-    format_db, format_factor, format_semitones, parse_db, parse_factor, parse_semitones,
-    parse_switch,
+    format_bend_range, format_db, format_factor, format_semitones, format_velocity_curve, parse_db,
+    parse_factor, parse_semitones, parse_switch, parse_velocity_curve,
 };
 use nice_plug::prelude::*;
 use ressort_engine::instrument::Controls;
@@ -12,6 +12,11 @@ use std::sync::Arc;
 /// Stiffness and Damping are stored in octaves (log₂ of the factor): the knob is logarithmic
 /// from ×1/16 to ×16 and automation lanes are linear in octaves.
 pub const GAIN_OCTAVES: f32 = 4.0;
+
+/// The Velocity Curve's exponent spans 2^±this.
+pub const VELOCITY_OCTAVES: f32 = 2.0;
+/// The widest pitch-bend range (MPE's member channels use ±48).
+pub const MAX_BEND_RANGE: f32 = 48.0;
 
 /// The texts of the Guard Tripped parameter.
 const GUARD_OFF: &str = "Clear";
@@ -45,6 +50,13 @@ pub struct RessortParams {
     /// model or by the user. Set by the plugin (see `report`), not automatable.
     #[id = "guard"]
     pub guard: BoolParam,
+
+    /// Semitones of a full pitch bend, up or down.
+    #[id = "bend_range"]
+    pub bend_range: FloatParam,
+    /// log₂ of the exponent a note's velocity is raised to before it strikes.
+    #[id = "velocity_curve"]
+    pub velocity_curve: FloatParam,
 
     /// Generic slots bound to the model's `param`s in declaration order.
     #[nested(array, group = "Macros")]
@@ -99,7 +111,8 @@ impl RessortParams {
             position_db: self.position_gain.value() as f64,
             macros: std::array::from_fn(|i| self.macros[i].value.value() as f64),
             dc_filter: self.dc_filter.value(),
-            ..Controls::DEFAULT
+            bend_range_st: self.bend_range.value() as f64,
+            velocity_exponent: 2f64.powf(self.velocity_curve.value() as f64),
         }
     }
 
@@ -119,6 +132,7 @@ impl RessortParams {
                 })),
             }
         });
+        let d = Controls::DEFAULT;
         RessortParams {
             model,
             stiffness: factor_param("Stiffness"),
@@ -135,10 +149,32 @@ impl RessortParams {
             .with_step_size(0.01)
             .with_value_to_string(Arc::new(format_semitones))
             .with_string_to_value(Arc::new(parse_semitones)),
-            output_gain: gain_param("Output Gain", 24.0, -40.0, 60.0),
-            force_gain: gain_param("Force Gain", 0.0, -60.0, 40.0),
-            position_gain: gain_param("Position Gain", 0.0, -60.0, 40.0),
-            dc_filter: BoolParam::new("DC Filter", true),
+            output_gain: gain_param("Output Gain", d.output_db as f32, -40.0, 60.0),
+            force_gain: gain_param("Force Gain", d.force_db as f32, -60.0, 40.0),
+            position_gain: gain_param("Position Gain", d.position_db as f32, -60.0, 40.0),
+            dc_filter: BoolParam::new("DC Filter", Controls::DEFAULT.dc_filter),
+            bend_range: FloatParam::new(
+                "Bend Range",
+                Controls::DEFAULT.bend_range_st as f32,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: MAX_BEND_RANGE,
+                },
+            )
+            .with_unit(" st")
+            .with_step_size(1.0)
+            .with_value_to_string(Arc::new(format_bend_range))
+            .with_string_to_value(Arc::new(parse_semitones)),
+            velocity_curve: FloatParam::new(
+                "Velocity Curve",
+                Controls::DEFAULT.velocity_exponent.log2() as f32,
+                FloatRange::Linear {
+                    min: -VELOCITY_OCTAVES,
+                    max: VELOCITY_OCTAVES,
+                },
+            )
+            .with_value_to_string(Arc::new(format_velocity_curve))
+            .with_string_to_value(Arc::new(|t| parse_velocity_curve(t, VELOCITY_OCTAVES))),
             guard: BoolParam::new("Guard Tripped", false)
                 .non_automatable()
                 .with_value_to_string(Arc::new(|on| {

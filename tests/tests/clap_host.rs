@@ -183,6 +183,8 @@ fn plugin_describes_its_ports_and_parameters() {
         "Position Gain",
         "DC Filter",
         "Guard Tripped",
+        "Bend Range",
+        "Velocity Curve",
     ]
     .iter()
     .map(|s| s.to_string())

@@ -154,3 +154,65 @@ fn a_note_retunes_at_its_own_sample() {
         "a note must change nothing before its sample and act at it"
     );
 }
+
+#[test]
+fn bend_range_and_velocity_curve_shape_the_notes() {
+    // Bend Range 12: a full bend up plays an octave higher.
+    let quiet = ("output_gain", json!({ "f32": -12.0 }));
+    let mut plugin = plugin_with_model(
+        "low-oscillator",
+        LOW_OSCILLATOR,
+        &[quiet.clone(), ("bend_range", json!({ "f32": 12.0 }))],
+    );
+    let frames = 48_000;
+    let pitch =
+        |audio: &Stereo| ressort_tests::peak_frequency(&audio.left[4_800..], SR, 50.0, 2_000.0);
+    plugin.activate(SR, 1, 512);
+    let straight = plugin
+        .render_frames(frames, 512, &Score::new().note_on(0, 60, 1.0))
+        .audio;
+    plugin.activate(SR, 1, 512);
+    let bent = plugin
+        .render_frames(
+            frames,
+            512,
+            &Score::new().pitch_bend(0, 1.0).note_on(0, 60, 1.0),
+        )
+        .audio;
+    let cents = ressort_tests::cents(pitch(&bent), pitch(&straight));
+    println!("Bend Range 12, full bend: {cents:+.2} cents");
+    assert!((cents - 1200.0).abs() < 2.0, "{cents} cents, not an octave");
+
+    // Velocity Curve 2 (stored as its log₂, 1): velocity 0.5 strikes as hard as 0.25 does on
+    // the linear curve, to the bit (0.5² is exact).
+    let mut curved = plugin_with_model(
+        "low-oscillator",
+        LOW_OSCILLATOR,
+        &[quiet.clone(), ("velocity_curve", json!({ "f32": 1.0 }))],
+    );
+    let mut linear = plugin_with_model("low-oscillator", LOW_OSCILLATOR, &[quiet]);
+    curved.activate(SR, 1, 512);
+    linear.activate(SR, 1, 512);
+    let a = curved
+        .render_frames(frames, 512, &Score::new().note_on(0, 60, 0.5))
+        .audio;
+    let b = linear
+        .render_frames(frames, 512, &Score::new().note_on(0, 60, 0.25))
+        .audio;
+    linear.activate(SR, 1, 512);
+    let c = linear
+        .render_frames(frames, 512, &Score::new().note_on(0, 60, 0.5))
+        .audio;
+    println!(
+        "velocity 0.5: curve 2 rms {:.5}, linear 0.25 rms {:.5}, linear 0.5 rms {:.5}",
+        a.rms(),
+        b.rms(),
+        c.rms()
+    );
+    assert!(a.rms() > 1e-4);
+    assert!(
+        a.bit_identical(&b),
+        "velocity 0.5 through curve 2 is not 0.25"
+    );
+    assert!(!a.bit_identical(&c), "the curve changed nothing");
+}
