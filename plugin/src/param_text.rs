@@ -139,6 +139,29 @@ pub fn parse_unbound_macro(text: &str) -> Option<f64> {
     Some(v.clamp(0.0, 1.0))
 }
 
+/// A pitch-bend range: whole semitones, `12 st` (the unit comes from `with_unit`).
+pub fn format_bend_range(st: f32) -> String {
+    format!("{:.0}", st.round())
+}
+
+/// A velocity curve's exponent (stored as its log₂): `1.00` is linear, `2.00` makes soft notes
+/// softer, `0.50` louder.
+pub fn format_velocity_curve(log2_exponent: f32) -> String {
+    format!("{:.2}", 2f32.powf(log2_exponent))
+}
+
+/// Reads a velocity-curve exponent (`2`, `0.5`, `v^2`, `linear`) as its log₂, clamped to
+/// `max_octaves`.
+pub fn parse_velocity_curve(text: &str, max_octaves: f32) -> Option<f32> {
+    let t = clean(text).to_ascii_lowercase();
+    if t == "linear" {
+        return Some(0.0);
+    }
+    let t = t.trim_start_matches("v^").trim();
+    let v = number(t)?;
+    (v > 0.0).then(|| (v.log2() as f32).clamp(-max_octaves, max_octaves))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -214,27 +237,4 @@ mod tests {
             prop_assert_eq!(format_semitones(parse_semitones(&text).unwrap()), text);
         }
     }
-}
-
-/// A pitch-bend range: whole semitones, `12 st` (the unit comes from `with_unit`).
-pub fn format_bend_range(st: f32) -> String {
-    format!("{:.0}", st.round())
-}
-
-/// A velocity curve's exponent (stored as its log₂): `1.00` is linear, `2.00` makes soft notes
-/// softer, `0.50` louder.
-pub fn format_velocity_curve(log2_exponent: f32) -> String {
-    format!("{:.2}", 2f32.powf(log2_exponent))
-}
-
-/// Reads a velocity-curve exponent (`2`, `0.5`, `v^2`, `linear`) as its log₂, clamped to
-/// `max_octaves`.
-pub fn parse_velocity_curve(text: &str, max_octaves: f32) -> Option<f32> {
-    let t = clean(text).to_ascii_lowercase();
-    if t == "linear" {
-        return Some(0.0);
-    }
-    let t = t.trim_start_matches("v^").trim();
-    let v = number(t)?;
-    (v > 0.0).then(|| (v.log2() as f32).clamp(-max_octaves, max_octaves))
 }
