@@ -445,22 +445,46 @@ pub struct ModelSpec {
 pub enum RouteSource {
     MainLeft,
     MainRight,
+    /// Sidechain channel 1.
     SidechainLeft,
+    /// Sidechain channel 2.
     SidechainRight,
+    /// Sidechain channel 3 … 8 (`sidechain_3` … `sidechain_8`), in the plugin's multichannel
+    /// layout.
+    Sidechain(u8),
     /// Fed by nothing but MIDI strikes.
     None,
 }
 
 impl RouteSource {
-    /// The script names: `main_left`, `main_right`, `sidechain_left`, `sidechain_right`,
-    /// `none`.
-    pub const NAMES: [(&'static str, RouteSource); 5] = [
+    /// The widest sidechain a host can feed.
+    pub const MAX_SIDECHAIN_CHANNELS: u8 = 8;
+
+    /// The script names: `main_left`, `main_right`, `sidechain_left` (also `sidechain_1`),
+    /// `sidechain_right` (`sidechain_2`), `sidechain_3` … `sidechain_8`, `none`.
+    pub const NAMES: [(&'static str, RouteSource); 11] = [
         ("main_left", RouteSource::MainLeft),
         ("main_right", RouteSource::MainRight),
         ("sidechain_left", RouteSource::SidechainLeft),
         ("sidechain_right", RouteSource::SidechainRight),
+        ("sidechain_3", RouteSource::Sidechain(3)),
+        ("sidechain_4", RouteSource::Sidechain(4)),
+        ("sidechain_5", RouteSource::Sidechain(5)),
+        ("sidechain_6", RouteSource::Sidechain(6)),
+        ("sidechain_7", RouteSource::Sidechain(7)),
+        ("sidechain_8", RouteSource::Sidechain(8)),
         ("none", RouteSource::None),
     ];
+
+    /// The sidechain channel `n` (1-based; 1 and 2 are left and right), if it exists.
+    pub fn sidechain(n: u8) -> Option<RouteSource> {
+        match n {
+            1 => Some(RouteSource::SidechainLeft),
+            2 => Some(RouteSource::SidechainRight),
+            3..=Self::MAX_SIDECHAIN_CHANNELS => Some(RouteSource::Sidechain(n)),
+            _ => None,
+        }
+    }
 
     pub fn name(self) -> &'static str {
         RouteSource::NAMES
@@ -471,6 +495,9 @@ impl RouteSource {
     }
 
     pub fn from_name(name: &str) -> Option<RouteSource> {
+        if let Some(n) = name.strip_prefix("sidechain_").and_then(|n| n.parse().ok()) {
+            return RouteSource::sidechain(n);
+        }
         RouteSource::NAMES
             .iter()
             .find(|(n, _)| *n == name)

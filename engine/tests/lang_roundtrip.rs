@@ -532,6 +532,49 @@ fn host_directives_round_trip() {
     assert_eq!(first, second);
 }
 
+/// Routes reach the multichannel sidechain: `sidechain_3` … `sidechain_8`, with `sidechain_1`
+/// and `sidechain_2` as the names of left and right; `sidechain_9` is an error.
+#[test]
+fn routes_name_every_sidechain_channel() {
+    use ressort_engine::RouteSource;
+    let text = "@m osc 1 0.1 0.001 0 0
+@in1 frcInput @m
+@in2 frcInput @m
+@in3 frcInput @m
+\
+                @out1 posOutput @m
+~route in1 sidechain_8
+~route in2 sidechain_1
+\
+                ~route in3 sidechain_3
+";
+    let spec = ressort_engine::parse(text).spec.expect("parses");
+    let sources: Vec<RouteSource> = spec.host.routes.iter().map(|r| r.source).collect();
+    assert_eq!(
+        sources,
+        [
+            RouteSource::Sidechain(8),
+            RouteSource::SidechainLeft,
+            RouteSource::Sidechain(3)
+        ]
+    );
+    let printed = ressort_engine::print(&spec);
+    assert!(printed.contains("~route in1 sidechain_8"), "{printed}");
+    assert_eq!(
+        ressort_engine::parse(&printed).spec.unwrap().host,
+        spec.host
+    );
+    let bad =
+        ressort_engine::parse("@m osc 1 0.1 0.001 0 0\n@in1 frcInput @m\n~route in1 sidechain_9\n");
+    let errors: Vec<String> = bad.errors().map(|d| d.to_string()).collect();
+    assert!(
+        errors
+            .iter()
+            .any(|e| e.contains("unknown input source `sidechain_9`")),
+        "{errors:?}"
+    );
+}
+
 /// An `audioParam` default survives printing; a zero default prints as the MIMS4Max form.
 #[test]
 fn audio_param_defaults_round_trip() {

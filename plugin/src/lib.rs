@@ -10,7 +10,9 @@
 
 use model::{ModelStore, Prepared};
 use nice_plug::prelude::*;
-use ressort_engine::instrument::{Controls, Event, Instrument, Timed, MAX_HOST_INPUTS};
+use ressort_engine::instrument::{
+    Controls, Event, Instrument, Timed, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS,
+};
 use std::num::NonZeroU32;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
@@ -266,6 +268,21 @@ impl Plugin for Ressort {
                 aux_outputs: &[],
             },
         },
+        // Multichannel instrument: an 8-channel sidechain feeds @in1 … @in8, and @out3 …
+        // @out8 leave on three stereo auxiliary outputs (docs/LANGUAGE.md, host routing).
+        AudioIOLayout {
+            main_input_channels: None,
+            main_output_channels: NonZeroU32::new(2),
+            aux_input_ports: &[new_nonzero_u32(8)],
+            aux_output_ports: &[new_nonzero_u32(2), new_nonzero_u32(2), new_nonzero_u32(2)],
+            names: PortNames {
+                layout: Some("Multichannel instrument"),
+                main_input: None,
+                main_output: Some("Output (out1, out2)"),
+                aux_inputs: &["Sidechain (in1 … in8)"],
+                aux_outputs: &["out3, out4", "out5, out6", "out7, out8"],
+            },
+        },
         // Effect without a sidechain: lets a host that feeds only the main bus switch the
         // sidechain off (pedalboard does when it can).
         AudioIOLayout {
@@ -382,13 +399,30 @@ impl Plugin for Ressort {
                 return Some(t);
             }
         }));
+        // Host outputs: main left and right (@out1, @out2), then the auxiliary pairs.
+        let mut outputs: [&mut [f32]; MAX_HOST_OUTPUTS] = Default::default();
+        let mut n_out = 0;
+        for ch in buffer.as_slice().iter_mut() {
+            if n_out < MAX_HOST_OUTPUTS {
+                outputs[n_out] = &mut **ch;
+                n_out += 1;
+            }
+        }
+        for port in aux.outputs.iter_mut() {
+            for ch in port.as_slice().iter_mut() {
+                if n_out < MAX_HOST_OUTPUTS {
+                    outputs[n_out] = &mut **ch;
+                    n_out += 1;
+                }
+            }
+        }
         let report = self.instrument.process(
             frames,
             &host_in,
             self.has_main_input,
             &mut events,
             &controls,
-            buffer.as_slice(),
+            &mut outputs[..n_out],
         );
         drop(events);
         self.audition_left = self.audition_left.saturating_sub(frames as u64);

@@ -478,8 +478,8 @@ impl HostEvent {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Block<'a> {
     pub frames: usize,
-    /// The stereo sidechain (aux input "Sidechain").
-    pub sidechain: Option<[&'a [f32]; 2]>,
+    /// The sidechain's channels in order (aux input "Sidechain"); empty: silent.
+    pub sidechain: &'a [&'a [f32]],
     /// The main input, used when the "Effect with sidechain" configuration is selected.
     pub main_input: Option<[&'a [f32]; 2]>,
     /// Events, with times relative to the block's start (sorted by the host before sending).
@@ -1076,6 +1076,17 @@ impl TestPlugin {
         }
     }
 
+    /// Every output channel of the last `process()` call, `frames` long: the main port's
+    /// first, then the other ports' in order.
+    pub fn all_outputs(&self, frames: usize) -> Vec<Vec<f32>> {
+        let io = self.io.as_ref().expect("active");
+        let main = io.outputs.iter().filter(|(p, _)| p.is_main);
+        let aux = io.outputs.iter().filter(|(p, _)| !p.is_main);
+        main.chain(aux)
+            .flat_map(|(_, channels)| channels.iter().map(|c| c[..frames].to_vec()))
+            .collect()
+    }
+
     fn process_inner(&mut self, block: &Block) -> ProcessStatus {
         let (Some(processor), Some(io)) = (self.processor.as_mut(), self.io.as_mut()) else {
             panic!("process() on an inactive plugin");
@@ -1087,15 +1098,15 @@ impl TestPlugin {
             io.config.max_frames_count
         );
         for (port, channels) in io.inputs.iter_mut() {
-            let source = if port.is_main {
-                block.main_input
+            let source: &[&[f32]] = if port.is_main {
+                block.main_input.as_ref().map_or(&[], |m| m.as_slice())
             } else {
                 block.sidechain
             };
             for (c, buffer) in channels.iter_mut().enumerate() {
                 let dst = &mut buffer[..n];
                 dst.fill(0.0);
-                if let Some(src) = source.and_then(|s| s.get(c).copied()) {
+                if let Some(src) = source.get(c).copied() {
                     let m = src.len().min(n);
                     dst[..m].copy_from_slice(&src[..m]);
                 }
@@ -1203,9 +1214,10 @@ impl TestPlugin {
                 .iter()
                 .map(|e| e.at(e.time().saturating_sub(start as u32)))
                 .collect();
+            let sc = [&sidechain.left[start..end], &sidechain.right[start..end]];
             let block = Block {
                 frames: n,
-                sidechain: Some([&sidechain.left[start..end], &sidechain.right[start..end]]),
+                sidechain: &sc,
                 main_input: main
                     .as_ref()
                     .map(|m| [&m.left[start..end], &m.right[start..end]]),

@@ -234,8 +234,9 @@ fn plugin_describes_its_ports_and_parameters() {
     assert_eq!(outputs.len(), 1);
     assert!(outputs[0].is_main);
     assert_eq!(outputs[0].channels, 2);
-    assert_eq!(configs.len(), 3);
+    assert_eq!(configs.len(), 4);
     assert!(configs.iter().any(|c| c == "Effect with sidechain"));
+    assert!(configs.iter().any(|c| c == "Multichannel instrument"));
     assert!(configs.iter().any(|c| c == "Effect"));
     assert_eq!(notes.len(), 1, "one note input");
     assert!(notes[0].dialects & 1 != 0, "note input accepts CLAP notes");
@@ -1124,7 +1125,7 @@ fn process_status_lets_the_host_sleep_only_when_quiet() {
     let impulse = [STRIKE];
     let out = plugin.process(&Block {
         frames: 1,
-        sidechain: Some([&impulse, &[0.0]]),
+        sidechain: &[&impulse, &[0.0]],
         ..Block::default()
     });
     assert_eq!(out.status, ProcessStatus::Continue);

@@ -4,27 +4,36 @@
 use crate::{MacroRange, ModelSpec, RouteSource};
 
 /// The default order: `@in1`, `@in2`… take the main input's left and right channels when
-/// the plugin has a main input (effect layout), then the sidechain's.
+/// the plugin has a main input (effect layouts), then the sidechain's channels 1 … 8.
 pub fn default_order(has_main_input: bool) -> &'static [RouteSource] {
+    const WITH_MAIN: [RouteSource; 10] = [
+        RouteSource::MainLeft,
+        RouteSource::MainRight,
+        RouteSource::SidechainLeft,
+        RouteSource::SidechainRight,
+        RouteSource::Sidechain(3),
+        RouteSource::Sidechain(4),
+        RouteSource::Sidechain(5),
+        RouteSource::Sidechain(6),
+        RouteSource::Sidechain(7),
+        RouteSource::Sidechain(8),
+    ];
     if has_main_input {
-        &[
-            RouteSource::MainLeft,
-            RouteSource::MainRight,
-            RouteSource::SidechainLeft,
-            RouteSource::SidechainRight,
-        ]
+        &WITH_MAIN
     } else {
-        &[RouteSource::SidechainLeft, RouteSource::SidechainRight]
+        &WITH_MAIN[2..]
     }
 }
 
-/// Index of a host channel in the plugin's per-chunk scratch; None for `none`.
+/// Index of a host channel in the instrument's per-chunk scratch: 0 and 1 the main input,
+/// 2 … 9 the sidechain's channels 1 … 8; None for `none`.
 pub fn channel(source: RouteSource) -> Option<usize> {
     match source {
         RouteSource::MainLeft => Some(0),
         RouteSource::MainRight => Some(1),
         RouteSource::SidechainLeft => Some(2),
         RouteSource::SidechainRight => Some(3),
+        RouteSource::Sidechain(n) => Some(1 + n as usize),
         RouteSource::None => None,
     }
 }

@@ -774,9 +774,13 @@ impl Builder<'_> {
         let (expected, count): (&str, &[usize]) = match name {
             "pitch" => ("a frequency in Hz (a positive number)", &[1]),
             "key" => ("a MIDI key number, 0 to 127", &[1]),
-            "note" => ("an input (`in1`…) and optionally the force of a full-velocity note", &[1, 2]),
+            "note" => (
+                "an input (`in1`…) and optionally the force of a full-velocity note",
+                &[1, 2],
+            ),
             "route" => (
-                "an input (`in1`…) and main_left, main_right, sidechain_left, sidechain_right or none",
+                "an input (`in1`…) and main_left, main_right, sidechain_left, sidechain_right, \
+                 sidechain_3 … sidechain_8 or none",
                 &[2],
             ),
             _ => ("a param name, then its minimum and maximum", &[3]),

@@ -145,6 +145,22 @@ pub fn matching(
 
 /// What the host said about the busses: the channel counts of its last accepted arrangement and
 /// which busses it activated.
+/// Whether the host may arrange the busses with these channel counts: some layout has every
+/// one of its busses at the count given. Busses that layout lacks may carry any arrangement,
+/// since they stay inactive while it is in use (JUCE arranges every bus, active or not).
+pub fn arrangeable(layouts: &[AudioIOLayout], inputs: &[u32], outputs: &[u32]) -> bool {
+    layouts.iter().any(|layout| {
+        let fits = |input: bool, counts: &[u32]| {
+            counts.len() == count(layouts, input)
+                && counts.iter().enumerate().all(|(i, &c)| {
+                    let own = channels_in(layouts, layout, input, i);
+                    own == 0 || own == c
+                })
+        };
+        fits(true, inputs) && fits(false, outputs)
+    })
+}
+
 #[derive(Debug, Clone, Default)]
 pub struct HostBusses {
     pub input_channels: Vec<u32>,
@@ -295,5 +311,18 @@ mod tests {
         assert_eq!(name(host.layout(LAYOUTS)), Some("Effect with sidechain"));
         host.input_active[1] = false;
         assert_eq!(name(host.layout(LAYOUTS)), Some("Effect"));
+    }
+
+    #[test]
+    fn busses_a_layout_lacks_may_carry_any_arrangement() {
+        // A host that arranges the main input in stereo while it stays inactive: the
+        // instrument layout still fits.
+        assert!(arrangeable(LAYOUTS, &[2, 2], &[2]));
+        assert!(arrangeable(LAYOUTS, &[0, 2], &[2]));
+        assert!(arrangeable(LAYOUTS, &[2, 0], &[2]));
+        // No layout has a mono output or a mono sidechain.
+        assert!(!arrangeable(LAYOUTS, &[0, 2], &[1]));
+        assert!(!arrangeable(LAYOUTS, &[0, 1], &[2]));
+        assert!(!arrangeable(LAYOUTS, &[2], &[2]));
     }
 }

@@ -773,10 +773,10 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
             return kInvalidArgument;
         }
 
-        // Ressort patch: the host arranges the union of the layouts' busses (see `busses`). An
-        // empty arrangement means the bus is absent; the arrangement is accepted when some
-        // layout has exactly the non-empty busses with these channel counts. The layout in use
-        // also depends on which busses the host activates.
+        // Ressort patch: the host arranges the union of the layouts' busses (see `busses`). The
+        // arrangement is accepted when some layout has each of its busses at the count given
+        // (busses it lacks stay inactive and may carry any arrangement); the layout in use is
+        // then chosen by which busses the host activates.
         // NOTE: Only the channel counts are compared, not the speaker positions.
         let counts = |arrangements: *mut SpeakerArrangement, n: int32| -> Vec<u32> {
             (0..n as usize)
@@ -785,7 +785,7 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
         };
         let input_counts = counts(inputs, num_ins);
         let output_counts = counts(outputs, num_outs);
-        if busses::matching(P::AUDIO_IO_LAYOUTS, &input_counts, &output_counts).is_none() {
+        if !busses::arrangeable(P::AUDIO_IO_LAYOUTS, &input_counts, &output_counts) {
             return kResultFalse;
         }
 
