@@ -7,6 +7,10 @@
 //! [`ModelStore::submit`], so a script with errors never replaces the running one, and the
 //! parameters only through the host's `ParamSetter`.
 
+use crate::files::{
+    preset_file_name, read_script, save_script, user_preset_dir, user_presets, FileBrowser,
+    UserPreset,
+};
 use crate::model::{ModelState, ModelStatus, ModelStore, NUM_MACROS};
 use crate::motion::MotionReader;
 use crate::params::RessortParams;
@@ -21,7 +25,7 @@ use nice_plug_egui::widgets::ParamSlider;
 use nice_plug_egui::{
     create_egui_editor, EguiEditor, EguiEditorState, EguiNiceSettings, NiceEguiApp, RepaintNotifier,
 };
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Instant;
@@ -35,8 +39,6 @@ const LEFT_PANEL: (f32, f32, f32) = (240.0, 380.0, 700.0);
 const RIGHT_PANEL: (f32, f32, f32) = (240.0, 300.0, 480.0);
 /// The width the side panels leave to the motion view when the window allows it.
 const MIN_VIEW_WIDTH: f32 = 300.0;
-/// Largest file the model panel loads.
-const MAX_SCRIPT_BYTES: u64 = 16 << 20;
 
 const ORANGE: Color32 = Color32::from_rgb(255, 165, 60);
 const RED: Color32 = Color32::from_rgb(255, 90, 80);
@@ -107,74 +109,6 @@ impl Diagnostic {
     }
 }
 
-/// A minimal file browser for `.mdl` scripts.
-struct FileBrowser {
-    dir: PathBuf,
-    path_text: String,
-    entries: Vec<(String, bool)>,
-    error: Option<String>,
-}
-
-impl FileBrowser {
-    fn new() -> FileBrowser {
-        let dir = std::env::var_os("HOME")
-            .map(PathBuf::from)
-            .or_else(|| std::env::current_dir().ok())
-            .unwrap_or_else(|| PathBuf::from("/"));
-        let mut b = FileBrowser {
-            path_text: dir.display().to_string(),
-            dir,
-            entries: Vec::new(),
-            error: None,
-        };
-        b.refresh();
-        b
-    }
-
-    fn go(&mut self, dir: PathBuf) {
-        self.dir = dir;
-        self.path_text = self.dir.display().to_string();
-        self.refresh();
-    }
-
-    fn refresh(&mut self) {
-        self.entries.clear();
-        self.error = None;
-        match std::fs::read_dir(&self.dir) {
-            Ok(rd) => {
-                for e in rd.flatten() {
-                    let name = e.file_name().to_string_lossy().into_owned();
-                    if name.starts_with('.') {
-                        continue;
-                    }
-                    let is_dir = e.file_type().map(|t| t.is_dir()).unwrap_or(false);
-                    if is_dir || name.ends_with(".mdl") {
-                        self.entries.push((name, is_dir));
-                    }
-                }
-                self.entries
-                    .sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
-            }
-            Err(e) => self.error = Some(format!("{}: {e}", self.dir.display())),
-        }
-    }
-}
-
-/// Reads a script file for the model panel.
-fn read_script(path: &Path) -> Result<String, String> {
-    let meta = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    if meta.len() > MAX_SCRIPT_BYTES {
-        return Err(format!(
-            "{}: {} bytes is larger than the {} MB a script may have",
-            path.display(),
-            meta.len(),
-            MAX_SCRIPT_BYTES >> 20
-        ));
-    }
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    Ok(String::from_utf8_lossy(&bytes).into_owned())
-}
-
 /// The editor's state between frames.
 pub struct EditorApp {
     params: Arc<RessortParams>,
@@ -196,6 +130,13 @@ pub struct EditorApp {
     synced: ModelState,
     message: Option<(String, Color32)>,
     browser: FileBrowser,
+    /// The user preset folder, its presets (read when the Presets tab opens or after a save),
+    /// and the name typed for the next save.
+    user_dir: Option<PathBuf>,
+    user: Vec<UserPreset>,
+    save_name: String,
+    /// The path typed for "Save as" in the file tab.
+    save_path: String,
     last_frame: Option<Instant>,
     frame_times: [f32; 32],
     frame_count: usize,
@@ -214,6 +155,7 @@ impl EditorApp {
             Some(r) => (r.script, r.name, Tab::Script),
             None => (running.script.clone(), running.name.clone(), Tab::Presets),
         };
+        let user_dir = user_preset_dir();
         EditorApp {
             params,
             script,
@@ -229,6 +171,10 @@ impl EditorApp {
             preset,
             message: None,
             browser: FileBrowser::new(),
+            user: user_dir.as_deref().map(user_presets).unwrap_or_default(),
+            user_dir,
+            save_name: String::new(),
+            save_path: String::new(),
             last_frame: None,
             frame_times: [0.0; 32],
             frame_count: 0,
@@ -287,6 +233,7 @@ impl EditorApp {
                 self.script = script;
                 self.script_name = name;
                 self.synced = self.store.running();
+                self.mark_edited();
             }
             Err(rejected) => {
                 self.script = script;
@@ -304,13 +251,69 @@ impl EditorApp {
         }
     }
 
+    /// Tells the host the project changed: a gesture on the hidden `model_edits` parameter
+    /// (see [`RessortParams::model_edits`]).
+    fn mark_edited(&self) {
+        if let Some(gui) = &self.gui {
+            let setter = gui.param_setter();
+            let p = &self.params.model_edits;
+            setter.begin_set_parameter(p);
+            setter.set_parameter(p, (p.value() + 1) % 256);
+            setter.end_set_parameter(p);
+        }
+    }
+
+    /// The A/B compare switch: the running slot is lit; the other one runs on a click.
+    fn compare_switch(&mut self, ui: &mut Ui) {
+        let compare = self.store.compare();
+        for (slot, label) in ["A", "B"].iter().enumerate() {
+            let name = compare.slots[slot]
+                .as_ref()
+                .map(|m| m.name.clone())
+                .unwrap_or_else(|| "empty: a copy of the running script".into());
+            let r = ui
+                .selectable_label(compare.active == slot, *label)
+                .on_hover_text(format!("Compare slot {label}: {name}"));
+            if r.clicked() && compare.active != slot {
+                match self.store.switch_compare() {
+                    Ok(()) => {
+                        let running = self.store.running();
+                        self.message =
+                            Some((format!("{label}: {} is running", running.name), GREEN));
+                        self.script = running.script.clone();
+                        self.script_name = running.name.clone();
+                        self.synced = running;
+                        self.mark_edited();
+                    }
+                    Err(r) => {
+                        self.message = Some((
+                            format!("slot {label} does not load: {}", r.0.join("; ")),
+                            RED,
+                        ))
+                    }
+                }
+            }
+        }
+        let other = ["B", "A"][compare.active];
+        if ui
+            .small_button(format!("→{other}"))
+            .on_hover_text(format!("Copy the running script into slot {other}"))
+            .clicked()
+        {
+            self.store.copy_to_other_slot();
+            self.message = Some((format!("copied into slot {other}"), GREEN));
+        }
+    }
+
     fn top_bar(&mut self, ui: &mut Ui, status: &ModelStatus) {
-        let rt = &self.store.runtime;
+        let store = self.store.clone();
+        let rt = &store.runtime;
         let s = &status.summary;
         ui.horizontal_wrapped(|ui| {
             ui.label(RichText::new("Ressort").strong().size(16.0));
             ui.separator();
             ui.label(RichText::new(&s.name).strong());
+            self.compare_switch(ui);
             ui.label(format!(
                 "{} points · {} interactions",
                 s.points, s.interactions
@@ -396,6 +399,78 @@ impl EditorApp {
             let p: &Preset = &PRESETS[i];
             self.submit(p.id.to_string(), p.text.to_string());
         }
+        ui.separator();
+        self.user_presets(ui);
+    }
+
+    /// The user preset folder: its scripts, and saving the running one there.
+    fn user_presets(&mut self, ui: &mut Ui) {
+        let Some(dir) = self.user_dir.clone() else {
+            ui.colored_label(ORANGE, "No user data folder on this system");
+            return;
+        };
+        ui.horizontal(|ui| {
+            ui.label(RichText::new("User presets").strong());
+            if ui.small_button("Refresh").clicked() {
+                self.user = user_presets(&dir);
+            }
+        });
+        ui.label(
+            RichText::new(dir.display().to_string())
+                .small()
+                .color(Color32::GRAY),
+        );
+        let mut open = None;
+        egui::ScrollArea::vertical()
+            .id_salt("user-presets")
+            .max_height(120.0)
+            .show(ui, |ui| {
+                if self.user.is_empty() {
+                    ui.label(RichText::new("none yet").small().color(Color32::GRAY));
+                }
+                for p in &self.user {
+                    if ui
+                        .selectable_label(false, &p.name)
+                        .on_hover_text("Click to load")
+                        .clicked()
+                    {
+                        open = Some(p.clone());
+                    }
+                }
+            });
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::TextEdit::singleline(&mut self.save_name)
+                    .hint_text("name")
+                    .desired_width(140.0),
+            );
+            if ui
+                .button("Save as preset")
+                .on_hover_text("Save the running script into the user preset folder")
+                .clicked()
+            {
+                match preset_file_name(&self.save_name) {
+                    None => self.message = Some(("type a name for the preset".into(), ORANGE)),
+                    Some(file) => {
+                        let path = dir.join(file);
+                        let running = self.store.running();
+                        match save_script(&path, &running.script) {
+                            Ok(()) => {
+                                self.message = Some((format!("saved {}", path.display()), GREEN));
+                                self.user = user_presets(&dir);
+                            }
+                            Err(e) => self.message = Some((e, RED)),
+                        }
+                    }
+                }
+            }
+        });
+        if let Some(p) = open {
+            match read_script(&p.path) {
+                Ok(text) => self.submit(p.name, text),
+                Err(e) => self.message = Some((e, RED)),
+            }
+        }
     }
 
     fn file_tab(&mut self, ui: &mut Ui) {
@@ -428,6 +503,29 @@ impl EditorApp {
         if let Some(e) = &self.browser.error {
             ui.colored_label(RED, e);
         }
+        ui.horizontal(|ui| {
+            if self.save_path.is_empty() {
+                let running = self.store.running();
+                let file = preset_file_name(&running.name).unwrap_or_else(|| "model.mdl".into());
+                self.save_path = self.browser.dir.join(file).display().to_string();
+            }
+            ui.add(egui::TextEdit::singleline(&mut self.save_path).desired_width(200.0));
+            if ui
+                .button("Save running script")
+                .on_hover_text("Write the running script to this .mdl file")
+                .clicked()
+            {
+                let path = PathBuf::from(self.save_path.trim());
+                let running = self.store.running();
+                match save_script(&path, &running.script) {
+                    Ok(()) => {
+                        self.message = Some((format!("saved {}", path.display()), GREEN));
+                        self.browser.refresh();
+                    }
+                    Err(e) => self.message = Some((e, RED)),
+                }
+            }
+        });
         egui::ScrollArea::vertical()
             .id_salt("files")
             .show(ui, |ui| {

@@ -18,6 +18,7 @@ use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
 pub mod editor;
+pub mod files;
 pub mod model;
 pub mod motion;
 pub mod param_text;

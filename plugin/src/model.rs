@@ -144,6 +144,15 @@ pub fn format_value(v: f64) -> String {
     }
 }
 
+/// A/B compare: two scripts, one of them running. A model change goes into the running slot;
+/// switching runs the other one (a copy of the first until it is edited).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Compare {
+    pub slots: [Option<ModelState>; 2],
+    /// 0 for A, 1 for B.
+    pub active: usize,
+}
+
 /// The model shared by the plugin, its parameters (as a persistent field) and the editor.
 #[derive(Debug)]
 pub struct ModelStore {
@@ -159,6 +168,8 @@ pub struct ModelStore {
     /// The motion reader of the newest model sent to the audio thread, until the editor
     /// takes it.
     motion: Mutex<Option<MotionReader>>,
+    /// The A/B compare slots (not saved with the project).
+    compare: Mutex<Compare>,
     /// What the audio thread reports.
     pub runtime: RuntimeStatus,
 }
@@ -177,6 +188,7 @@ impl Default for ModelStore {
             to_audio: crossbeam_channel::bounded(4),
             garbage: crossbeam_channel::bounded(64),
             motion: Mutex::new(None),
+            compare: Mutex::new(Compare::default()),
             runtime: RuntimeStatus::default(),
         }
     }
@@ -259,6 +271,10 @@ impl ModelStore {
                     *lock(&self.motion) = Some(reader);
                     self.send(Box::new(p));
                 }
+                let mut compare = lock(&self.compare);
+                let active = compare.active;
+                compare.slots[active] = Some(state.clone());
+                drop(compare);
                 *lock(&self.running) = state;
                 Ok(())
             }
@@ -269,6 +285,42 @@ impl ModelStore {
                 Err(rejected)
             }
         }
+    }
+
+    /// The A/B slots and which one runs.
+    pub fn compare(&self) -> Compare {
+        let mut c = lock(&self.compare).clone();
+        if c.slots[c.active].is_none() {
+            c.slots[c.active] = Some(self.running());
+        }
+        c
+    }
+
+    /// Runs the other A/B slot: its script, or a copy of the running one when it is empty
+    /// (so B starts where A is). A slot whose script no longer loads keeps the running model
+    /// and reports why.
+    pub fn switch_compare(&self) -> Result<(), Rejected> {
+        let running = self.running();
+        let mut c = lock(&self.compare);
+        let from = c.active;
+        let to = 1 - from;
+        c.slots[from] = Some(running.clone());
+        let target = c.slots[to].clone().unwrap_or(running);
+        c.active = to;
+        drop(c);
+        let result = self.submit(target);
+        if result.is_err() {
+            lock(&self.compare).active = from;
+        }
+        result
+    }
+
+    /// Copies the running script into the other A/B slot.
+    pub fn copy_to_other_slot(&self) {
+        let running = self.running();
+        let mut c = lock(&self.compare);
+        let other = 1 - c.active;
+        c.slots[other] = Some(running);
     }
 
     fn send(&self, prepared: Box<Prepared>) {

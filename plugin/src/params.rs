@@ -51,6 +51,14 @@ pub struct RessortParams {
     #[id = "guard"]
     pub guard: BoolParam,
 
+    /// Counts the editor's model changes (script edits, presets, files, A/B), wrapping at 255.
+    /// The editor moves it with a parameter gesture whenever it changes the model, so the host
+    /// records an edit of the project: nice-plug 0.4.2 has no other way to mark a project
+    /// dirty (no `clap_host_state.mark_dirty`, no VST3 `setDirty`). Hidden, not automatable;
+    /// its value means nothing.
+    #[id = "model_edits"]
+    pub model_edits: IntParam,
+
     /// Semitones of a full pitch bend, up or down.
     #[id = "bend_range"]
     pub bend_range: FloatParam,
@@ -153,6 +161,9 @@ impl RessortParams {
             force_gain: gain_param("Force Gain", d.force_db as f32, -60.0, 40.0),
             position_gain: gain_param("Position Gain", d.position_db as f32, -60.0, 40.0),
             dc_filter: BoolParam::new("DC Filter", Controls::DEFAULT.dc_filter),
+            model_edits: IntParam::new("Model Edits", 0, IntRange::Linear { min: 0, max: 255 })
+                .hide()
+                .non_automatable(),
             bend_range: FloatParam::new(
                 "Bend Range",
                 Controls::DEFAULT.bend_range_st as f32,

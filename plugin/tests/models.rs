@@ -370,3 +370,42 @@ fn chladni_listening_point_is_a_macro_knob() {
     );
     assert!(peak(&diff) > 0.1 * peak(&centre));
 }
+
+#[test]
+fn ab_compare_switches_between_two_scripts() {
+    let store = ModelStore::default();
+    let a = ModelState {
+        name: "a".into(),
+        script: "@o osc 1. 0.1 0.001 0. 0.\n@out1 posOutput @o\n".into(),
+    };
+    let b = ModelState {
+        name: "b".into(),
+        script: "@o osc 1. 0.2 0.001 0. 0.\n@out1 posOutput @o\n".into(),
+    };
+    store.activate(48_000.0).expect("the default preset runs");
+    store.submit(a.clone()).unwrap();
+    assert_eq!(store.compare().active, 0);
+    // B starts as a copy of A.
+    store.switch_compare().unwrap();
+    assert_eq!(store.compare().active, 1);
+    assert_eq!(store.running(), a);
+    // An edit goes into B; A keeps its script.
+    store.submit(b.clone()).unwrap();
+    let c = store.compare();
+    assert_eq!(c.slots, [Some(a.clone()), Some(b.clone())]);
+    store.switch_compare().unwrap();
+    assert_eq!(store.running(), a);
+    store.switch_compare().unwrap();
+    assert_eq!(store.running(), b);
+    // A script with errors changes neither the running model nor the slots.
+    let broken = ModelState {
+        name: "broken".into(),
+        script: "@o osc 1. 0.1\n".into(),
+    };
+    assert!(store.submit(broken).is_err());
+    assert_eq!(store.compare().slots, [Some(a.clone()), Some(b.clone())]);
+    // Copying the running script over the other slot.
+    store.copy_to_other_slot();
+    assert_eq!(store.compare().slots, [Some(b.clone()), Some(b)]);
+    store.deactivate();
+}

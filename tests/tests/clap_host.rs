@@ -209,6 +209,11 @@ fn plugin_describes_its_ports_and_parameters() {
         0
     );
     assert_eq!(plugin.param_text(guard.id, 0.0).as_deref(), Some("Clear"));
+    // The editor's model-change counter: hidden and not automatable, it only makes hosts
+    // record an edit of the project.
+    let edits = plugin.param("Model Edits");
+    assert_eq!(edits.flags & CLAP_PARAM_IS_AUTOMATABLE, 0);
+    assert_ne!(edits.flags & CLAP_PARAM_IS_HIDDEN, 0);
 
     // The documented plain ranges, through the plugin's own value texts.
     let p = Params::of(&mut plugin);

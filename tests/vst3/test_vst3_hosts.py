@@ -54,6 +54,7 @@ PARAMETERS = [
     "position_gain_db",
     "dc_filter",
     "guard_tripped",
+    "model_edits",
     "bend_range_st",
     "velocity_curve",
 ] + [f"macro_{i}" for i in range(1, 17)]
