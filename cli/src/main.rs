@@ -109,6 +109,9 @@ struct RenderArgs {
         allow_hyphen_values = true
     )]
     controls: Vec<String>,
+    /// Map a MIDI controller to a macro slot, as the editor's MIDI learn does: `74=macro1`.
+    #[arg(long = "cc", value_name = "CC=macroN")]
+    cc_maps: Vec<String>,
 }
 
 #[derive(Args, Debug)]

@@ -1,5 +1,5 @@
 //! Standard MIDI files (types 0 and 1, read with `midly`) as the instrument's events at
-//! absolute sample times: notes and pitch bend of every track and channel, with the file's
+//! absolute sample times: notes, pitch bend and control changes of every track and channel, with the file's
 //! tempo map (metrical time) or its SMPTE rate (timecode).
 
 use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
@@ -54,6 +54,10 @@ pub fn read_events(bytes: &[u8], sample_rate: f64) -> Result<Vec<(u64, Event)>, 
                     }
                     MidiMessage::PitchBend { bend } => Event::PitchBend {
                         value: (bend.as_int() as f32 + 8192.0) / 16383.0,
+                    },
+                    MidiMessage::Controller { controller, value } => Event::Controller {
+                        cc: controller.as_int(),
+                        value: value.as_int() as f32 / 127.0,
                     },
                     _ => continue,
                 };

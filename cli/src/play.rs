@@ -19,6 +19,7 @@ pub fn wanted(a: &RenderArgs) -> bool {
         || a.midi.is_some()
         || !a.notes.is_empty()
         || !a.controls.is_empty()
+        || !a.cc_maps.is_empty()
         || a.sidechain.is_some()
         || a.main.is_some()
 }
@@ -89,6 +90,31 @@ fn set_control(c: &mut Controls, text: &str) -> Result<(), Failure> {
             )))
         }
     }
+    Ok(())
+}
+
+/// `--cc CC=macroN`: MIDI controller CC (1 … 127) moves macro slot N.
+fn cc_map(map: &mut [Option<u8>; instrument::NUM_MACROS], text: &str) -> Result<(), Failure> {
+    let bad = || {
+        usage(format!(
+            "--cc {text}: expected CC=macroN with CC 1 … 127 and N 1 … {}, e.g. 74=macro1",
+            instrument::NUM_MACROS
+        ))
+    };
+    let (cc, slot) = text.split_once('=').ok_or_else(bad)?;
+    let cc: u8 = cc
+        .trim()
+        .parse()
+        .ok()
+        .filter(|c| (1..=127).contains(c))
+        .ok_or_else(bad)?;
+    let slot: usize = slot
+        .trim()
+        .strip_prefix("macro")
+        .and_then(|n| n.parse().ok())
+        .filter(|n| (1..=instrument::NUM_MACROS).contains(n))
+        .ok_or_else(bad)?;
+    map[slot - 1] = Some(cc);
     Ok(())
 }
 
@@ -260,7 +286,12 @@ pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
     } else {
         model.num_outputs.min(MAX_HOST_OUTPUTS).div_ceil(2) * 2
     };
+    let mut ccs = [None; instrument::NUM_MACROS];
+    for m in &a.cc_maps {
+        cc_map(&mut ccs, m)?;
+    }
     let mut inst = Instrument::new(srf, controls);
+    inst.set_cc_map(&ccs);
     inst.set_main_input(has_main);
     inst.set_model(Box::new(model));
 

@@ -256,6 +256,11 @@ fn bad_plugin_options_are_clear_errors() {
             "--input and --impulse feed model inputs directly",
         ),
         (vec!["--as-plugin", "--set", "Q=1"], "unknown parameter `Q`"),
+        (
+            vec!["--cc", "200=macro1"],
+            "--cc 200=macro1: expected CC=macroN",
+        ),
+        (vec!["--cc", "74=macro0"], "expected CC=macroN"),
     ] {
         let mut all = vec!["render", m, "-o", o];
         all.extend(args.iter().copied());
@@ -264,4 +269,80 @@ fn bad_plugin_options_are_clear_errors() {
         assert_eq!(run.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(expected), "{args:?}: {err}");
     }
+}
+
+#[test]
+fn a_mapped_controller_in_a_midi_file_moves_its_macro() {
+    let dir = tempfile::tempdir().unwrap();
+    let (model, out) = paths(dir.path());
+    let mid = dir.path().join("cc.mid");
+    let track = vec![
+        TrackEvent {
+            delta: u28::new(0),
+            kind: TrackEventKind::Midi {
+                channel: u4::new(0),
+                message: MidiMessage::Controller {
+                    controller: u7::new(74),
+                    value: u7::new(127),
+                },
+            },
+        },
+        TrackEvent {
+            delta: u28::new(0),
+            kind: TrackEventKind::Midi {
+                channel: u4::new(0),
+                message: MidiMessage::NoteOn {
+                    key: u7::new(60),
+                    vel: u7::new(100),
+                },
+            },
+        },
+    ];
+    Smf {
+        header: Header::new(Format::SingleTrack, Timing::Metrical(u15::new(480))),
+        tracks: vec![track],
+    }
+    .save(&mid)
+    .unwrap();
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            model.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--sample-rate",
+            "48000",
+            "--samples",
+            "12000",
+            "--midi",
+            mid.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let run = ressort(&args);
+        assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+        read_wav(&out)
+    };
+    let unmapped = render(&[]);
+    let mapped = render(&["--cc", "74=macro1"]);
+    let direct = instrument_render(
+        &Controls::DEFAULT,
+        &[
+            (0, Event::Controller { cc: 74, value: 1.0 }),
+            (
+                0,
+                Event::NoteOn {
+                    note: 60,
+                    velocity: 100.0 / 127.0,
+                },
+            ),
+        ],
+        &[],
+        12_000,
+    );
+    assert_ne!(
+        mapped[0], unmapped[0],
+        "CC 74 on Macro 1 must change the sound"
+    );
+    // The direct render has no map: it equals the unmapped file.
+    assert_eq!(direct[0], unmapped[0]);
 }

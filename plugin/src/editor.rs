@@ -767,6 +767,8 @@ impl EditorApp {
                     .color(Color32::GRAY),
             );
         }
+        let ccs = &p.cc_map;
+        let learning = ccs.learning();
         for (i, b) in &bound {
             ui.horizontal(|ui| {
                 ui.label(RichText::new(format!("{}", i + 1)).color(Color32::GRAY));
@@ -781,7 +783,24 @@ impl EditorApp {
                     .color(Color32::GRAY),
                 );
             });
-            ui.add(ParamSlider::for_param(&p.macros[*i].value, &setter));
+            ui.horizontal(|ui| {
+                ui.add(ParamSlider::for_param(&p.macros[*i].value, &setter));
+                self.cc_learn(ui, *i, learning);
+            });
+            if let Some(cc) = ccs.cc_of(*i) {
+                let host = p.macros[*i].value.value() as f64;
+                let used = rt.macros[*i].load(Ordering::Relaxed);
+                if (used - host).abs() > 1e-6 {
+                    ui.label(
+                        RichText::new(format!(
+                            "CC {cc} holds it at {:.0} % (the knob takes over when moved)",
+                            used * 100.0
+                        ))
+                        .small()
+                        .color(ORANGE),
+                    );
+                }
+            }
         }
         let unbound = NUM_MACROS - bound.len();
         if !bound.is_empty() && unbound > 0 {
@@ -790,6 +809,41 @@ impl EditorApp {
                     .small()
                     .color(Color32::GRAY),
             );
+        }
+    }
+
+    /// MIDI learn for macro slot `slot`: its controller, a button that arms it (the next
+    /// controller the plugin hears is bound), and one that unbinds it.
+    fn cc_learn(&self, ui: &mut Ui, slot: usize, learning: Option<usize>) {
+        let ccs = &self.params.cc_map;
+        if learning == Some(slot) {
+            if ui
+                .button(RichText::new("move a control…").color(ORANGE))
+                .on_hover_text("Waiting for a MIDI controller; click to stop")
+                .clicked()
+            {
+                ccs.learn(None);
+            }
+            return;
+        }
+        let label = match ccs.cc_of(slot) {
+            Some(cc) => format!("CC {cc}"),
+            None => "Learn".to_string(),
+        };
+        if ui
+            .small_button(label)
+            .on_hover_text("MIDI learn: click, then move a knob or pedal on your controller")
+            .clicked()
+        {
+            ccs.learn(Some(slot));
+        }
+        if ccs.cc_of(slot).is_some()
+            && ui
+                .small_button("×")
+                .on_hover_text("Unbind the controller")
+                .clicked()
+        {
+            ccs.clear(slot);
         }
     }
 

@@ -19,6 +19,7 @@ use std::sync::Arc;
 
 pub mod editor;
 pub mod files;
+pub mod midi_learn;
 pub mod model;
 pub mod motion;
 pub mod param_text;
@@ -228,6 +229,7 @@ fn instrument_event(event: NoteEvent<()>) -> Option<Timed> {
             note: key.number()?,
         },
         NoteEvent::MidiPitchBend { value, .. } => Event::PitchBend { value },
+        NoteEvent::MidiCC { cc, value, .. } => Event::Controller { cc, value },
         _ => return None,
     };
     Some(Timed::new(timing, e))
@@ -394,8 +396,14 @@ impl Plugin for Ressort {
                 velocity: AUDITION_VELOCITY,
             },
         ));
+        // MIDI learn hears every controller before the instrument maps it.
+        let cc_map = &self.params.cc_map;
+        self.instrument.set_cc_map(&cc_map.mapping());
         let mut events = strike.into_iter().chain(std::iter::from_fn(|| loop {
             let e = context.next_event()?;
+            if let NoteEvent::MidiCC { cc, .. } = e {
+                cc_map.heard(cc);
+            }
             if let Some(t) = instrument_event(e) {
                 return Some(t);
             }
@@ -427,6 +435,10 @@ impl Plugin for Ressort {
         );
         drop(events);
         self.audition_left = self.audition_left.saturating_sub(frames as u64);
+        let macros = self.instrument.macros();
+        for (a, v) in self.store.runtime.macros.iter().zip(macros) {
+            a.store(v, Ordering::Relaxed);
+        }
         let retired = self.instrument.take_retired();
         self.recycle(retired);
         self.report(report.trips, context);
@@ -475,10 +487,17 @@ impl Vst3Plugin for Ressort {
         Vst3SubCategory::Fx,
     ];
     /// VST3 delivers MIDI controllers as proxy parameters, one per controller and channel,
-    /// and JUCE-based hosts list every one (2,080 for all of them). The plugin reads pitch
-    /// bend (129) only; a controller it starts to read goes in this list.
-    const VST3_MIDI_CONTROLLERS: &'static [u8] = &[129];
+    /// and JUCE-based hosts list every one (2,080 for all of them, which took pedalboard
+    /// 112 s to load). The plugin lists pitch bend and the controllers MIDI learn offers
+    /// ([`VST3_CONTROLLERS`]); a controller it starts to read goes in that list.
+    const VST3_MIDI_CONTROLLERS: &'static [u8] = &VST3_CONTROLLERS;
 }
+
+/// The controllers VST3 hosts deliver (as proxy parameters on each of the 16 channels): pitch
+/// bend (129) and the controllers people put on knobs and pedals, for MIDI learn: modulation
+/// wheel 1, breath 2, foot 4, volume 7, expression 11, general purpose 16–19, sustain 64 and
+/// the sound controllers 71–74. CLAP and the standalone deliver every controller.
+pub const VST3_CONTROLLERS: [u8; 15] = [1, 2, 4, 7, 11, 16, 17, 18, 19, 64, 71, 72, 73, 74, 129];
 
 nice_export_clap!(Ressort);
 nice_export_vst3!(Ressort);

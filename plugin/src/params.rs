@@ -1,5 +1,6 @@
 //! The plugin's parameters. Their ids are part of every saved project: never rename one.
 
+use crate::midi_learn::CcMap;
 use crate::model::{ModelStore, NUM_MACROS};
 use crate::param_text::{
     format_bend_range, format_db, format_factor, format_semitones, format_velocity_curve, parse_db,
@@ -27,6 +28,10 @@ pub struct RessortParams {
     /// The running model's script (saved with the project).
     #[persist = "model"]
     pub model: Arc<ModelStore>,
+
+    /// Which MIDI controller moves which macro slot (MIDI learn; saved with the project).
+    #[persist = "cc_map"]
+    pub cc_map: Arc<CcMap>,
 
     /// × on every K-class argument (log₂ of the factor).
     #[id = "stiffness"]
@@ -143,6 +148,7 @@ impl RessortParams {
         let d = Controls::DEFAULT;
         RessortParams {
             model,
+            cc_map: Arc::new(CcMap::default()),
             stiffness: factor_param("Stiffness"),
             damping: factor_param("Damping"),
             tune: FloatParam::new(

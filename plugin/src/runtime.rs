@@ -27,6 +27,9 @@ pub struct RuntimeStatus {
     pub strike_requested: AtomicBool,
     /// The editor's Audition switch: strike the note input every second.
     pub audition: AtomicBool,
+    /// The macro slot positions in use (a MIDI controller may have moved a slot away from its
+    /// parameter's value).
+    pub macros: [AtomicF64; crate::model::NUM_MACROS],
     /// Set by the editor's reset button; the audio thread resets the model at its next block
     /// and clears the guard flag.
     pub reset_requested: AtomicBool,
@@ -47,6 +50,7 @@ impl Default for RuntimeStatus {
             strike_requested: AtomicBool::new(false),
             audition: AtomicBool::new(false),
             reset_requested: AtomicBool::new(false),
+            macros: std::array::from_fn(|_| AtomicF64::new(0.5)),
         }
     }
 }

@@ -415,6 +415,8 @@ pub enum HostEvent {
     /// A MIDI 1 pitch bend on channel 0 (`value` in -1..=1, 0 = centre), sent as a 14-bit
     /// CLAP MIDI event.
     PitchBend { time: u32, value: f64 },
+    /// A MIDI 1 control change on channel 0 (`value` 0..=127), as a CLAP MIDI event.
+    Controller { time: u32, cc: u8, value: u8 },
     /// A parameter change to a plain value.
     Param { time: u32, id: ClapId, value: f64 },
 }
@@ -425,6 +427,7 @@ impl HostEvent {
             HostEvent::NoteOn { time, .. }
             | HostEvent::NoteOff { time, .. }
             | HostEvent::PitchBend { time, .. }
+            | HostEvent::Controller { time, .. }
             | HostEvent::Param { time, .. } => time,
         }
     }
@@ -435,6 +438,7 @@ impl HostEvent {
             HostEvent::NoteOn { time, .. }
             | HostEvent::NoteOff { time, .. }
             | HostEvent::PitchBend { time, .. }
+            | HostEvent::Controller { time, .. }
             | HostEvent::Param { time, .. } => *time = t,
         }
         self
@@ -464,6 +468,10 @@ impl HostEvent {
             HostEvent::PitchBend { time, value } => {
                 let v = Self::pitch_bend_14bit(value);
                 let data = [0xE0, (v & 0x7f) as u8, (v >> 7) as u8];
+                buffer.push(&MidiEvent::new(time, 0, data));
+            }
+            HostEvent::Controller { time, cc, value } => {
+                let data = [0xB0, cc & 0x7f, value & 0x7f];
                 buffer.push(&MidiEvent::new(time, 0, data));
             }
             HostEvent::Param { time, id, value } => {
@@ -564,6 +572,15 @@ impl Score {
 
     pub fn pitch_bend(self, frame: u32, value: f64) -> Score {
         self.event(HostEvent::PitchBend { time: frame, value })
+    }
+
+    /// A MIDI control change (0..=127) on channel 0.
+    pub fn controller(self, frame: u32, cc: u8, value: u8) -> Score {
+        self.event(HostEvent::Controller {
+            time: frame,
+            cc,
+            value,
+        })
     }
 
     pub fn param(self, frame: u32, id: ClapId, value: f64) -> Score {
@@ -1413,6 +1430,13 @@ pub mod state {
         let mut v = json(blob).expect("a valid state blob");
         let model = serde_json::json!({ "name": name, "script": script }).to_string();
         v["fields"]["model"] = Value::String(model);
+        blob_from(&v)
+    }
+
+    /// A copy of a state blob with a persistent field set to `json` (its JSON text).
+    pub fn with_field(blob: &[u8], name: &str, json: &str) -> Vec<u8> {
+        let mut v = self::json(blob).expect("a valid state blob");
+        v["fields"][name] = Value::String(json.to_string());
         blob_from(&v)
     }
 

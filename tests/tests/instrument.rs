@@ -216,3 +216,88 @@ fn bend_range_and_velocity_curve_shape_the_notes() {
     );
     assert!(!a.bit_identical(&c), "the curve changed nothing");
 }
+
+#[test]
+fn a_learned_controller_moves_its_macro_like_the_knob() {
+    // CC 74 on Macro 1 (saved in the state as MIDI learn leaves it). A full CC at the first
+    // sample plays exactly what automating Macro 1 to its top at that sample plays (both
+    // glide through the 15 ms smoother); an unmapped controller changes nothing.
+    let with_map = |params: &[(&str, serde_json::Value)]| {
+        let mut plugin = plugin_with_model("small-mesh", SMALL_MESH, params);
+        let blob = ressort_tests::state::with_field(&plugin.save_state(), "cc_map", "[[1,74]]");
+        plugin
+            .load_state(&blob)
+            .expect("state with a controller map");
+        let saved = plugin.save_state();
+        let field = ressort_tests::state::json(&saved).unwrap()["fields"]["cc_map"].clone();
+        assert_eq!(
+            field,
+            json!("[[1,74]]"),
+            "the map is saved with the project"
+        );
+        plugin
+    };
+    let frames = 12_000;
+    let strike = Score::new().note_on(0, 60, 1.0);
+    let mut mapped = with_map(&[]);
+    mapped.activate(SR, 1, 512);
+    let by_cc = mapped
+        .render_frames(frames, 512, &strike.clone().controller(0, 74, 127))
+        .audio;
+    mapped.activate(SR, 1, 512);
+    let other_cc = mapped
+        .render_frames(frames, 512, &strike.clone().controller(0, 1, 127))
+        .audio;
+    let mut knob = plugin_with_model("small-mesh", SMALL_MESH, &[]);
+    let macro_1 = knob.param("Macro 1").id;
+    let strike = &strike;
+    knob.activate(SR, 1, 512);
+    let by_knob = knob
+        .render_frames(frames, 512, &strike.clone().param(0, macro_1, 1.0))
+        .audio;
+    let mut plain = plugin_with_model("small-mesh", SMALL_MESH, &[]);
+    plain.activate(SR, 1, 512);
+    let untouched = plain.render_frames(frames, 512, &strike).audio;
+    println!(
+        "CC 74 → Macro 1: first difference from the knob {:?}, from the untouched model {:?}",
+        by_cc.first_difference(&by_knob),
+        by_cc.first_difference(&untouched)
+    );
+    assert!(untouched.rms() > 1e-4);
+    assert!(
+        by_cc.bit_identical(&by_knob),
+        "CC 74 = 127 must play Macro 1 at 1"
+    );
+    assert!(!by_cc.bit_identical(&untouched));
+    assert!(other_cc.bit_identical(&untouched), "CC 1 is not mapped");
+
+    // The host moves the knob after the controller: its value takes over.
+    mapped.activate(SR, 1, 512);
+    let handed_back = mapped
+        .render_frames(
+            frames,
+            512,
+            &strike
+                .clone()
+                .controller(0, 74, 127)
+                .param(6_000, macro_1, 0.2),
+        )
+        .audio;
+    // A fresh instance: the first one's Macro 1 stands at 1 since its automation.
+    let mut knob = plugin_with_model("small-mesh", SMALL_MESH, &[]);
+    knob.activate(SR, 1, 512);
+    let knob_only = knob
+        .render_frames(
+            frames,
+            512,
+            &strike
+                .clone()
+                .param(0, macro_1, 1.0)
+                .param(6_000, macro_1, 0.2),
+        )
+        .audio;
+    assert!(
+        handed_back.bit_identical(&knob_only),
+        "the host's automation must take the slot back from the controller"
+    );
+}

@@ -44,7 +44,10 @@ def routed_oscillator(source: str) -> str:
 #: membrane; a negative force moves it towards the membrane).
 STRIKE = -0.05
 
-#: The plugin's own parameters (before the MIDI pitch-bend proxies).
+#: The MIDI controllers the VST3 plugin lists as proxies (`VST3_CONTROLLERS` in the plugin).
+VST3_CONTROLLERS = [1, 2, 4, 7, 11, 16, 17, 18, 19, 64, 71, 72, 73, 74, "bend"]
+
+#: The plugin's own parameters (before the MIDI controller proxies).
 PARAMETERS = [
     "stiffness",
     "damping",
@@ -83,10 +86,15 @@ def test_pedalboard_loads_the_plugin_with_its_parameters():
     plugin = pedalboard.load_plugin(str(bundle()))
     names = list(plugin.parameters.keys())
     assert names[: len(PARAMETERS)] == PARAMETERS
-    # VST3 delivers pitch bend through one hidden proxy parameter per MIDI channel; the
-    # plugin lists no other MIDI controller proxies.
+    # VST3 delivers MIDI controllers through hidden proxy parameters, one per controller and
+    # channel: the plugin lists the ones MIDI learn offers and pitch bend, nothing else.
     proxies = names[len(PARAMETERS) :]
-    assert proxies == [f"midi_ch_{c}_pitch_bend" for c in range(1, 17)], proxies
+    expected = [
+        f"midi_ch_{c}_cc_{cc}" if cc != "bend" else f"midi_ch_{c}_pitch_bend"
+        for c in range(1, 17)
+        for cc in VST3_CONTROLLERS
+    ]
+    assert proxies == expected, proxies
     assert plugin.is_instrument
 
 
@@ -192,7 +200,7 @@ def test_dawdreamer_loads_the_plugin_with_stereo_input_and_output():
     assert plugin.get_num_output_channels() == 2
     names = [plugin.get_parameter_name(i) for i in range(plugin.get_plugin_parameter_size())]
     assert names[:3] == ["Stiffness", "Damping", "Tune"]
-    assert len(names) == len(PARAMETERS) + 16
+    assert len(names) == len(PARAMETERS) + 16 * len(VST3_CONTROLLERS)
 
 
 def test_dawdreamer_sidechain_clicks_strike_the_model():

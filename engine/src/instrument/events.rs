@@ -15,6 +15,9 @@ pub enum Event {
     /// A strike without retuning (the editor's Strike and Audition), `velocity` 0 … 1,
     /// linear.
     Strike { velocity: f32 },
+    /// A MIDI control change, `value` 0 … 1: it moves the macro slots mapped to `cc`
+    /// ([`super::Instrument::set_cc_map`]) from this sample on, until the host moves them.
+    Controller { cc: u8, value: f32 },
 }
 
 /// An event at sample `timing` of the block being processed.

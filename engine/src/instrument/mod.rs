@@ -102,6 +102,12 @@ pub struct Instrument {
     order: &'static [RouteSource],
     /// Whether the model's watcher should publish (an open editor).
     watching: bool,
+    /// The MIDI controller mapped to each macro slot.
+    cc_map: [Option<u8>; NUM_MACROS],
+    /// The macro positions the host last gave, and the ones a controller set since (they
+    /// hold until the host's value moves).
+    host_macros: [f64; NUM_MACROS],
+    cc_macros: [Option<f64>; NUM_MACROS],
     host_in: [[f64; CHUNK]; MAX_HOST_INPUTS],
 }
 
@@ -130,6 +136,9 @@ impl Instrument {
             bend_st: 0.0,
             order: host::default_order(false),
             watching: false,
+            cc_map: [None; NUM_MACROS],
+            host_macros: controls.macros,
+            cc_macros: [None; NUM_MACROS],
             host_in: [[0.0; CHUNK]; MAX_HOST_INPUTS],
         }
     }
@@ -147,6 +156,17 @@ impl Instrument {
     /// Whether someone watches the model's motion (the editor is open).
     pub fn set_watching(&mut self, watching: bool) {
         self.watching = watching;
+    }
+
+    /// Maps MIDI controllers to macro slots: a [`Event::Controller`] of a mapped number moves
+    /// the slot. Realtime-safe.
+    pub fn set_cc_map(&mut self, map: &[Option<u8>; NUM_MACROS]) {
+        self.cc_map = *map;
+    }
+
+    /// The macro slot positions in use: the host's, or a controller's since.
+    pub fn macros(&self) -> [f64; NUM_MACROS] {
+        self.controls.macros
     }
 
     /// The running model.
@@ -204,6 +224,8 @@ impl Instrument {
         self.note_st = 0.0;
         self.bend_st = 0.0;
         self.controls = controls.sanitized();
+        self.host_macros = self.controls.macros;
+        self.cc_macros = [None; NUM_MACROS];
         self.smoothed = Smoothed::snapped(&self.controls, self.sample_rate);
         self.last_output_gain = self.smoothed.output_gain.value;
         self.output = OutputStage::new(self.sample_rate);
@@ -268,7 +290,17 @@ impl Instrument {
         controls: &Controls,
         out: &mut [&mut [f32]],
     ) -> BlockReport {
-        let controls = controls.sanitized();
+        let mut controls = controls.sanitized();
+        // A slot a controller moved keeps the controller's value until the host moves it.
+        for (i, m) in controls.macros.iter_mut().enumerate() {
+            if *m != self.host_macros[i] {
+                self.host_macros[i] = *m;
+                self.cc_macros[i] = None;
+            }
+            if let Some(v) = self.cc_macros[i] {
+                *m = v;
+            }
+        }
         let mut automated = controls != self.controls;
         self.controls = controls;
         let mut report = BlockReport::default();
@@ -295,6 +327,9 @@ impl Instrument {
                     }
                     Event::PitchBend { value } => {
                         self.bend_st = events::bend_semitones(value, self.controls.bend_range_st);
+                    }
+                    Event::Controller { cc, value } => {
+                        automated |= self.controller(cc, value);
                     }
                     Event::NoteOff { .. } => {}
                 }
@@ -330,12 +365,33 @@ impl Instrument {
                         self.note_st = note as f64 - m.settings.reference_key;
                     }
                 }
+                Event::Controller { cc, value } => {
+                    self.controller(cc, value);
+                }
                 _ => {}
             }
             next = events.next();
         }
         report.fading = self.fade_left > 0;
         report
+    }
+
+    /// A control change: moves the slots mapped to `cc`. Returns whether one moved.
+    fn controller(&mut self, cc: u8, value: f32) -> bool {
+        let v = if value.is_finite() {
+            value.clamp(0.0, 1.0) as f64
+        } else {
+            return false;
+        };
+        let mut moved = false;
+        for slot in 0..NUM_MACROS {
+            if self.cc_map[slot] == Some(cc) {
+                self.cc_macros[slot] = Some(v);
+                moved |= self.controls.macros[slot] != v;
+                self.controls.macros[slot] = v;
+            }
+        }
+        moved
     }
 
     /// One span of `len` samples at `pos` within one chunk: inputs, the models, the output
