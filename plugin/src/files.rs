@@ -39,7 +39,7 @@ pub fn user_presets(dir: &Path) -> Vec<UserPreset> {
             (is_script && !name.starts_with('.')).then_some(UserPreset { name, path })
         })
         .collect();
-    out.sort_by(|a, b| a.name.to_lowercase().cmp(&b.name.to_lowercase()));
+    out.sort_by_key(|p| p.name.to_lowercase());
     out
 }
 
