@@ -112,6 +112,10 @@ struct RenderArgs {
     /// Map a MIDI controller to a macro slot, as the editor's MIDI learn does: `74=macro1`.
     #[arg(long = "cc", value_name = "CC=macroN")]
     cc_maps: Vec<String>,
+    /// Notes sounding at once, each on its own copy of the model (the plugin's Voices; 1 is
+    /// monophonic: a note retunes the one model).
+    #[arg(long, value_name = "N")]
+    voices: Option<usize>,
 }
 
 #[derive(Args, Debug)]
@@ -124,6 +128,10 @@ struct BenchArgs {
     /// Simulated duration in seconds.
     #[arg(long, default_value_t = 5.0)]
     seconds: f64,
+    /// Run a bank of N voices of the model, all struck at the start with different tunings
+    /// (the plugin's polyphony, through its instrument).
+    #[arg(long, value_name = "N")]
+    voices: Option<usize>,
 }
 
 /// Why a command failed: bad model (exit 1) or usage / I/O (exit 2). The message is printed
@@ -422,6 +430,9 @@ fn bench(a: &BenchArgs) -> Result<(), Failure> {
             "invalid --seconds {}: it must be in (0, 3600]",
             a.seconds
         )));
+    }
+    if let Some(voices) = a.voices {
+        return play::bench_voices(&a.model, a.sample_rate, a.seconds, voices);
     }
     let bytes = std::fs::read(&a.model)
         .map_err(|e| usage(format!("cannot read {}: {e}", a.model.display())))?;

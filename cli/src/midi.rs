@@ -46,11 +46,17 @@ pub fn read_events(bytes: &[u8], sample_rate: f64) -> Result<Vec<(u64, Event)>, 
             TrackEventKind::Midi { message, .. } => {
                 let event = match message {
                     MidiMessage::NoteOn { key, vel } if vel.as_int() > 0 => Event::NoteOn {
+                        channel: 0,
+                        voice_id: None,
                         note: key.as_int(),
                         velocity: vel.as_int() as f32 / 127.0,
                     },
                     MidiMessage::NoteOn { key, .. } | MidiMessage::NoteOff { key, .. } => {
-                        Event::NoteOff { note: key.as_int() }
+                        Event::NoteOff {
+                            channel: 0,
+                            voice_id: None,
+                            note: key.as_int(),
+                        }
                     }
                     MidiMessage::PitchBend { bend } => Event::PitchBend {
                         value: (bend.as_int() as f32 + 8192.0) / 16383.0,
@@ -124,13 +130,26 @@ mod tests {
             (
                 0,
                 Event::NoteOn {
+                    channel: 0,
+                    voice_id: None,
                     note: 60,
                     velocity: 1.0
                 }
             )
         );
         assert_eq!(events[1].0, 24_000, "half a second at 120 bpm");
-        assert_eq!(events[2], (72_000, Event::NoteOff { note: 67 }), "then 1 s");
+        assert_eq!(
+            events[2],
+            (
+                72_000,
+                Event::NoteOff {
+                    channel: 0,
+                    voice_id: None,
+                    note: 67
+                }
+            ),
+            "then 1 s"
+        );
     }
 
     #[test]

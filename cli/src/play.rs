@@ -7,6 +7,11 @@ use crate::{midi, read_wav_channels, usage, Failure, RenderArgs};
 use ressort_engine::instrument::{
     self, Controls, Event, Instrument, Prepared, Timed, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS,
 };
+use std::path::Path;
+use std::time::Instant;
+
+/// The most voices `--voices` takes.
+pub const MAX_VOICES: usize = 1024;
 
 /// Host block size of the render. The instrument's output does not depend on it.
 const BLOCK: usize = 512;
@@ -20,6 +25,7 @@ pub fn wanted(a: &RenderArgs) -> bool {
         || !a.notes.is_empty()
         || !a.controls.is_empty()
         || !a.cc_maps.is_empty()
+        || a.voices.is_some()
         || a.sidechain.is_some()
         || a.main.is_some()
 }
@@ -195,6 +201,8 @@ fn note(text: &str, sample_rate: f64) -> Result<(u64, Event), Failure> {
     Ok((
         (at * sample_rate).round() as u64,
         Event::NoteOn {
+            channel: 0,
+            voice_id: None,
             note: key,
             velocity,
         },
@@ -227,6 +235,14 @@ pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
             return Err(Failure::Model);
         }
     };
+    if let Some(v) = a.voices {
+        if !(1..=MAX_VOICES).contains(&v) {
+            return Err(usage(format!(
+                "--voices {v}: the plugin plays 1 to {MAX_VOICES} voices"
+            )));
+        }
+        model.set_voices(v);
+    }
     let mut controls = Controls::DEFAULT;
     for c in &a.controls {
         set_control(&mut controls, c)?;
@@ -369,6 +385,83 @@ pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
         sr,
         channels,
         peak
+    );
+    Ok(())
+}
+
+/// `ressort bench MODEL --voices N`: a bank of N voices through the instrument, every voice
+/// struck at the first sample on its own note (the reference key, then a semitone apart,
+/// wrapping over two octaves), then left to ring; the last line is `bench`'s, for the whole
+/// bank.
+pub fn bench_voices(
+    model: &Path,
+    sample_rate: f64,
+    seconds: f64,
+    voices: usize,
+) -> Result<(), Failure> {
+    if !(1..=MAX_VOICES).contains(&voices) {
+        return Err(usage(format!(
+            "--voices {voices}: the bank takes 1 to {MAX_VOICES} voices"
+        )));
+    }
+    if !(sample_rate.is_finite() && sample_rate > 0.0) {
+        return Err(usage(format!("invalid sample rate {sample_rate}")));
+    }
+    let text = std::fs::read_to_string(model)
+        .map_err(|e| usage(format!("cannot read {}: {e}", model.display())))?;
+    let start = Instant::now();
+    let mut prepared = match instrument::prepare("bench", &text, sample_rate) {
+        Ok(m) => m,
+        Err(rejected) => {
+            for line in &rejected.0 {
+                eprintln!("{}:{line}", model.display());
+            }
+            return Err(Failure::Model);
+        }
+    };
+    let compile_ms = start.elapsed().as_secs_f64() * 1e3;
+    prepared.set_voices(voices);
+    let (points, interactions) = (
+        prepared.engine.info().num_points,
+        prepared.engine.info().num_interactions,
+    );
+    let key = prepared.settings.reference_key.round().clamp(0.0, 127.0) as u8;
+    let controls = Controls::DEFAULT;
+    let mut inst = Instrument::new(sample_rate, controls);
+    inst.set_model(Box::new(prepared));
+    let notes: Vec<Timed> = (0..voices)
+        .map(|i| {
+            let note = (key as usize + i % 25).saturating_sub(12).min(127) as u8;
+            Timed::new(0, Event::note_on(note, 0.8))
+        })
+        .collect();
+    let block = 64;
+    let total = (seconds * sample_rate).round().max(1.0) as u64;
+    let (mut l, mut r) = (vec![0.0f32; block], vec![0.0f32; block]);
+    let no_input: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+    let t = Instant::now();
+    let mut done = 0u64;
+    let mut most = 0;
+    while done < total {
+        let first = done == 0;
+        let mut events = notes.iter().copied().filter(|_| first);
+        let mut out: [&mut [f32]; 2] = [&mut l, &mut r];
+        inst.process(block, &no_input, false, &mut events, &controls, &mut out);
+        most = most.max(inst.voice_count().0);
+        done += block as u64;
+    }
+    let ns_per_sample = t.elapsed().as_secs_f64() * 1e9 / done as f64;
+    let realtime_factor = 1e9 / sample_rate / ns_per_sample;
+    eprintln!(
+        "{}: {voices} voices ({most} sounding at most, {} at the end), {done} samples at \
+         {sample_rate} Hz, {:.2} % of one core",
+        model.display(),
+        inst.voice_count().0,
+        100.0 / realtime_factor
+    );
+    println!(
+        "ns_per_sample={ns_per_sample:.3} realtime_factor={realtime_factor:.3} points={points} \
+         interactions={interactions} compile_ms={compile_ms:.3} voices={voices}"
     );
     Ok(())
 }

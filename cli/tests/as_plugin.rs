@@ -154,6 +154,8 @@ fn render_as_plugin_writes_what_the_instrument_plays() {
         (
             0,
             Event::NoteOn {
+                channel: 0,
+                voice_id: None,
                 note: 60,
                 velocity: 0.9,
             },
@@ -161,6 +163,8 @@ fn render_as_plugin_writes_what_the_instrument_plays() {
         (
             12_000,
             Event::NoteOn {
+                channel: 0,
+                voice_id: None,
                 note: 67,
                 velocity: 0.5,
             },
@@ -214,6 +218,8 @@ fn render_midi_plays_each_note_at_its_time() {
             (
                 24_000,
                 Event::NoteOn {
+                    channel: 0,
+                    voice_id: None,
                     note: 60,
                     velocity: 100.0 / 127.0,
                 },
@@ -221,6 +227,8 @@ fn render_midi_plays_each_note_at_its_time() {
             (
                 48_000,
                 Event::NoteOn {
+                    channel: 0,
+                    voice_id: None,
                     note: 72,
                     velocity: 60.0 / 127.0,
                 },
@@ -331,6 +339,8 @@ fn a_mapped_controller_in_a_midi_file_moves_its_macro() {
             (
                 0,
                 Event::NoteOn {
+                    channel: 0,
+                    voice_id: None,
                     note: 60,
                     velocity: 100.0 / 127.0,
                 },

@@ -579,7 +579,7 @@ pub enum GuardKind {
 pub const DEFAULT_POSITION_LIMIT: f64 = 1.0e4;
 
 /// A compiled model and its running state. Built by [`crate::compile`].
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Engine {
     pub(crate) info: ModelInfo,
 
@@ -609,7 +609,7 @@ pub struct Engine {
 
     // Parameters.
     pub(crate) program: Program,
-    pub(crate) stack: Vec<f64>,
+    pub(crate) stack: crate::expr::EvalStack,
     /// Current parameter values, by parameter id.
     pub(crate) params: Vec<f64>,
     /// Arguments that depend on no audio-rate parameter: re-evaluated when a control

@@ -419,8 +419,8 @@ impl Program {
     }
 
     /// A stack with enough capacity for every expression of this program.
-    pub(crate) fn new_stack(&self) -> Vec<f64> {
-        Vec::with_capacity(self.max_stack.max(1))
+    pub(crate) fn new_stack(&self) -> EvalStack {
+        EvalStack(Vec::with_capacity(self.max_stack.max(1)))
     }
 
     /// Evaluates `e` against the parameter values. `stack` comes from [`Program::new_stack`]
@@ -526,5 +526,31 @@ mod tests {
             vec![Expr::Num(5.0), Expr::Num(3.0), Expr::Num(1.0)],
         );
         assert_eq!(c.eval(&lookup), 1.0);
+    }
+}
+
+/// The evaluation stack of an engine, reserved once at its full depth
+/// ([`Program::new_stack`]). A clone reserves the same capacity (a derived `Vec` clone would
+/// reserve only its length, 0), so a cloned engine — a voice — never allocates when it first
+/// evaluates an argument on the audio thread.
+#[derive(Debug, Default)]
+pub(crate) struct EvalStack(pub(crate) Vec<f64>);
+
+impl Clone for EvalStack {
+    fn clone(&self) -> Self {
+        EvalStack(Vec::with_capacity(self.0.capacity()))
+    }
+}
+
+impl std::ops::Deref for EvalStack {
+    type Target = Vec<f64>;
+    fn deref(&self) -> &Vec<f64> {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for EvalStack {
+    fn deref_mut(&mut self) -> &mut Vec<f64> {
+        &mut self.0
     }
 }

@@ -111,6 +111,68 @@ fn main() {
             );
         }
     }
+    // The instrument with a voice bank through a storm of 10,000 notes (stealing, releasing,
+    // the sustain pedal, controllers, pitch bend), host input, and a reset.
+    {
+        use ressort_engine::instrument::{self, Controls, Event, Instrument, Timed};
+        let script = "@K param 0.05\n@o osc 1. K 0.0005 0. 0.\n@g ground 0.1\n@h mass 1. 0.1 0.\n\
+                      @hs springDamper @g @h 0.0001 0.01\n@hit contact @o @h 0.1 0.001\n\
+                      @in1 frcInput @h\n@out1 posOutput @o\n";
+        let mut model = instrument::prepare("storm", script, 48_000.0).unwrap();
+        model.set_voices(16);
+        let controls = Controls {
+            release: 0.5,
+            ..Controls::DEFAULT
+        };
+        let mut inst = Instrument::new(48_000.0, controls);
+        inst.set_model(Box::new(model));
+        inst.set_cc_map(&std::array::from_fn(|i| (i == 0).then_some(74)));
+        let frames = 512;
+        let side = vec![0.01f32; frames];
+        let (mut l, mut r) = (vec![0.0f32; frames], vec![0.0f32; frames]);
+        let mut ended = 0usize;
+        let (notes, allocations) = counted(|| {
+            let mut notes = 0usize;
+            let mut block = 0u32;
+            while notes < 10_000 {
+                let base = notes;
+                let events = (0..64u32).map(move |k| {
+                    let n = base + k as usize;
+                    let event = match k % 8 {
+                        0..=4 => Event::note_on((24 + n % 80) as u8, 0.5),
+                        5 => Event::note_off((24 + (n - 3) % 80) as u8),
+                        6 => Event::Controller {
+                            cc: if block.is_multiple_of(2) { 64 } else { 74 },
+                            value: 0.9,
+                        },
+                        _ => Event::PitchBend { value: 0.7 },
+                    };
+                    Timed::new(k * 8, event)
+                });
+                let mut events = events;
+                let host_in: [Option<&[f32]>; 4] = [None, None, Some(&side), None];
+                let mut out: [&mut [f32]; 2] = [&mut l, &mut r];
+                inst.process(frames, &host_in, false, &mut events, &controls, &mut out);
+                inst.drain_ended(|_| ended += 1);
+                notes += 40;
+                block += 1;
+            }
+            inst.reset(controls);
+            notes
+        });
+        if allocations == 0 && notes >= 10_000 && ended > 0 {
+            passed += 1;
+            println!(
+                "test no_alloc::instrument_note_storm ... ok ({notes} notes, {ended} voices ended)"
+            );
+        } else {
+            failed += 1;
+            println!(
+                "test no_alloc::instrument_note_storm ... FAILED ({allocations} allocations, \
+                 {ended} voices ended)"
+            );
+        }
+    }
     // At least one reference model has an audio-rate parameter, or its path went unchecked.
     if audio_params_set == 0 {
         println!("test no_alloc::audio_rate_parameters ... FAILED (no model has one)");

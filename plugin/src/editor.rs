@@ -321,6 +321,14 @@ impl EditorApp {
             if let Some(f) = s.reference_pitch_hz {
                 ui.label(format!("{f:.1} Hz at key {}", s.reference_key));
             }
+            let total = rt.voices_total.load(Ordering::Relaxed);
+            if total > 1 {
+                ui.label(format!(
+                    "voices {}/{total}",
+                    rt.voices_sounding.load(Ordering::Relaxed)
+                ))
+                .on_hover_text("Voices sounding, of the Voices setting");
+            }
             ui.separator();
             let load = rt.cpu_load.load(Ordering::Relaxed) * 100.0;
             ui.label(format!("CPU {load:.1} %"))
@@ -713,6 +721,20 @@ impl EditorApp {
         row(ui, "Position in", &|ui| {
             ui.add(ParamSlider::for_param(&p.position_gain, &setter));
         });
+        row(ui, "Voices", &|ui| {
+            ui.add(ParamSlider::for_param(&p.voices, &setter))
+                .on_hover_text(
+                    "Notes sounding at once: 1 plays the one model (a note retunes it); more \
+                     give every note its own copy, which frees itself when it comes to rest",
+                );
+        });
+        row(ui, "Release", &|ui| {
+            ui.add(ParamSlider::for_param(&p.release, &setter))
+                .on_hover_text(
+                    "A damper on a voice whose key is up: 0 lets it ring as a struck object \
+                     does; 100 % multiplies its damping by 16",
+                );
+        });
         row(ui, "Bend range", &|ui| {
             ui.add(ParamSlider::for_param(&p.bend_range, &setter))
                 .on_hover_text("Semitones of a full pitch bend, up or down (MPE uses 48)");
@@ -957,6 +979,8 @@ impl NiceEguiApp for EditorApp {
         self.last_frame = Some(now);
         self.frame_times[self.frame_count % self.frame_times.len()] = dt;
         self.frame_count += 1;
+        // A new Voices setting from the host: re-prepare the model here, off the audio thread.
+        self.store.apply_voices();
         if let Some(r) = self.store.take_motion_reader() {
             self.reader = Some(r);
         }

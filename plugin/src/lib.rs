@@ -9,6 +9,7 @@
 //! pitch) are clamped to what the model's stability analysis allows.
 
 use model::{ModelStore, Prepared};
+use nice_plug::midi::{Channel, Key, VoiceID};
 use nice_plug::prelude::*;
 use ressort_engine::instrument::{
     Controls, Event, Instrument, Timed, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS,
@@ -59,6 +60,8 @@ pub struct Ressort {
     quiet_samples: u64,
     /// A strike from the editor waits for the next block.
     pending_strike: bool,
+    /// A main-thread task to apply a new Voices setting is on its way.
+    voices_task_queued: bool,
 }
 
 /// How `ressort-standalone` starts: its `--model` and `--audition` options.
@@ -103,6 +106,7 @@ impl Default for Ressort {
             held: [None, None, None, None],
             quiet_samples: 0,
             pending_strike: false,
+            voices_task_queued: false,
         }
     }
 }
@@ -221,12 +225,27 @@ impl Ressort {
 fn instrument_event(event: NoteEvent<()>) -> Option<Timed> {
     let timing = event.timing();
     let e = match event {
-        NoteEvent::NoteOn { key, velocity, .. } => Event::NoteOn {
+        NoteEvent::NoteOn {
+            key,
+            velocity,
+            channel,
+            voice_id,
+            ..
+        } => Event::NoteOn {
             note: key.number()?,
             velocity,
+            channel: channel.number().unwrap_or(0),
+            voice_id: voice_id.id(),
         },
-        NoteEvent::NoteOff { key, .. } => Event::NoteOff {
+        NoteEvent::NoteOff {
+            key,
+            channel,
+            voice_id,
+            ..
+        } => Event::NoteOff {
             note: key.number()?,
+            channel: channel.number().unwrap_or(0),
+            voice_id: voice_id.id(),
         },
         NoteEvent::MidiPitchBend { value, .. } => Event::PitchBend { value },
         NoteEvent::MidiCC { cc, value, .. } => Event::Controller { cc, value },
@@ -326,8 +345,10 @@ impl Plugin for Ressort {
     fn task_executor(&mut self) -> TaskExecutor<Self> {
         let params = self.params.clone();
         let link = self.host_link.clone();
+        let store = self.store.clone();
         Box::new(move |task| match task {
             MainThreadTask::ReportGuardTrip => link.set_guard(&params, true),
+            MainThreadTask::ApplyVoices => store.apply_voices(),
         })
     }
 
@@ -442,6 +463,31 @@ impl Plugin for Ressort {
         let retired = self.instrument.take_retired();
         self.recycle(retired);
         self.report(report.trips, context);
+        // Voices that ended: CLAP hosts end their polyphonic modulation there.
+        let last = frames.saturating_sub(1) as u32;
+        self.instrument.drain_ended(|e| {
+            let _ = context.try_send_event(NoteEvent::VoiceTerminated {
+                timing: last,
+                voice_id: e.voice_id.map_or(VoiceID::Wildcard, VoiceID::ID),
+                channel: Channel::Number(e.channel),
+                key: Key::Number(e.note),
+            });
+        });
+        let (sounding, total) = self.instrument.voice_count();
+        let rt = &self.store.runtime;
+        rt.voices_sounding.store(sounding as u32, Ordering::Relaxed);
+        rt.voices_total.store(total as u32, Ordering::Relaxed);
+        // A new Voices setting: CLAP runs the re-preparation on the main thread now; other
+        // formats at the next activation or when the editor sees it.
+        if self.store.voices_stale()
+            && !std::mem::replace(&mut self.voices_task_queued, true)
+            && context.plugin_api() == PluginApi::Clap
+        {
+            context.execute_gui(MainThreadTask::ApplyVoices);
+        }
+        if !self.store.voices_stale() {
+            self.voices_task_queued = false;
+        }
 
         let rt = &self.store.runtime;
         let seconds = frames as f64 / self.sample_rate;

@@ -20,7 +20,10 @@ pub use ressort_engine::instrument::{
 };
 use ressort_engine::InputUse;
 use serde::{Deserialize, Serialize};
-use std::sync::atomic::{AtomicU64, Ordering};
+
+/// The largest Voices setting.
+pub const MAX_VOICES: usize = 64;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// The saved part of the model: the script of the running model and where it came from.
@@ -34,12 +37,15 @@ pub struct ModelState {
 
 /// Prepares a script for the instrument ([`instrument::prepare`]) with a motion channel for
 /// the editor: the model publishes its positions, the reader goes to the editor.
+/// `voices` is the Voices setting (1 plays monophonically).
 pub fn prepare(
     name: &str,
     text: &str,
     sample_rate: f64,
+    voices: usize,
 ) -> Result<(Prepared, MotionReader), Rejected> {
     let mut prepared = instrument::prepare(name, text, sample_rate)?;
+    prepared.set_voices(voices);
     let (writer, reader) = motion_channel(&prepared.engine, sample_rate);
     prepared.watcher = Some(Box::new(writer));
     Ok((prepared, reader))
@@ -168,6 +174,10 @@ pub struct ModelStore {
     /// The motion reader of the newest model sent to the audio thread, until the editor
     /// takes it.
     motion: Mutex<Option<MotionReader>>,
+    /// The Voices setting the next model is prepared with, and whether the running model was
+    /// prepared with another.
+    voices: AtomicU64,
+    voices_stale: AtomicBool,
     /// The A/B compare slots (not saved with the project).
     compare: Mutex<Compare>,
     /// What the audio thread reports.
@@ -189,6 +199,8 @@ impl Default for ModelStore {
             garbage: crossbeam_channel::bounded(64),
             motion: Mutex::new(None),
             compare: Mutex::new(Compare::default()),
+            voices: AtomicU64::new(1),
+            voices_stale: AtomicBool::new(false),
             runtime: RuntimeStatus::default(),
         }
     }
@@ -256,7 +268,7 @@ impl ModelStore {
         self.collect_garbage();
         let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
         let result = if rate > 0.0 {
-            prepare(&state.name, &state.script, rate).map(Some)
+            prepare(&state.name, &state.script, rate, self.voices()).map(Some)
         } else {
             parse_script(&state.script).map(|_| None)
         };
@@ -283,6 +295,39 @@ impl ModelStore {
                 status.diagnostics = rejected.0.clone();
                 status.rejected = Some(state);
                 Err(rejected)
+            }
+        }
+    }
+
+    /// The Voices setting new models are prepared with.
+    pub fn voices(&self) -> usize {
+        self.voices
+            .load(Ordering::Acquire)
+            .clamp(1, MAX_VOICES as u64) as usize
+    }
+
+    /// The Voices parameter moved (on any thread, the audio thread included: this only
+    /// stores). The running model is re-prepared by [`ModelStore::apply_voices`] on the main
+    /// thread or by the next activation.
+    pub fn set_voices(&self, voices: usize) {
+        let old = self.voices.swap(voices as u64, Ordering::AcqRel);
+        if old != voices as u64 {
+            self.voices_stale.store(true, Ordering::Release);
+        }
+    }
+
+    /// Whether the running model was prepared with another Voices setting.
+    pub fn voices_stale(&self) -> bool {
+        self.voices_stale.load(Ordering::Acquire)
+    }
+
+    /// Re-prepares the running script with the current Voices setting (main thread; a
+    /// no-op while inactive or when nothing changed).
+    pub fn apply_voices(&self) {
+        if self.voices_stale.swap(false, Ordering::AcqRel) {
+            let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
+            if rate > 0.0 {
+                let _ = self.submit(self.running());
             }
         }
     }
@@ -334,16 +379,19 @@ impl ModelStore {
     /// Compiles the running script for `sample_rate` at activation. When it cannot be
     /// compiled at this rate, the default preset runs instead and the diagnostics say why.
     pub fn activate(&self, sample_rate: f64) -> Option<Box<Prepared>> {
+        self.voices_stale.store(false, Ordering::Release);
         self.collect_garbage();
         while self.to_audio.1.try_recv().is_ok() {}
         self.sample_rate
             .store(sample_rate.to_bits(), Ordering::Release);
         let state = self.running();
-        let (mut prepared, reader) = match prepare(&state.name, &state.script, sample_rate) {
+        let voices = self.voices();
+        let (mut prepared, reader) = match prepare(&state.name, &state.script, sample_rate, voices)
+        {
             Ok(p) => p,
             Err(rejected) => {
                 let preset = crate::presets::Preset::default_preset();
-                let fallback = prepare(preset.id, preset.text, sample_rate).ok()?;
+                let fallback = prepare(preset.id, preset.text, sample_rate, voices).ok()?;
                 let mut status = lock(&self.status);
                 status.diagnostics = rejected.0;
                 status.rejected = Some(state);

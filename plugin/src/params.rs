@@ -1,7 +1,7 @@
 //! The plugin's parameters. Their ids are part of every saved project: never rename one.
 
 use crate::midi_learn::CcMap;
-use crate::model::{ModelStore, NUM_MACROS};
+use crate::model::{ModelStore, MAX_VOICES, NUM_MACROS};
 use crate::param_text::{
     format_bend_range, format_db, format_factor, format_semitones, format_velocity_curve, parse_db,
     parse_factor, parse_semitones, parse_switch, parse_velocity_curve,
@@ -64,6 +64,16 @@ pub struct RessortParams {
     #[id = "model_edits"]
     pub model_edits: IntParam,
 
+    /// How many notes sound at once: 1 plays monophonically (a note retunes the one model);
+    /// more give every note its own copy of the model. Not automatable: a change re-prepares
+    /// the model.
+    #[id = "voices"]
+    pub voices: IntParam,
+
+    /// The damper laid on a voice when its key goes up: 0 lets it ring.
+    #[id = "release"]
+    pub release: FloatParam,
+
     /// Semitones of a full pitch bend, up or down.
     #[id = "bend_range"]
     pub bend_range: FloatParam,
@@ -125,6 +135,7 @@ impl RessortParams {
             macros: std::array::from_fn(|i| self.macros[i].value.value() as f64),
             dc_filter: self.dc_filter.value(),
             bend_range_st: self.bend_range.value() as f64,
+            release: self.release.value() as f64,
             velocity_exponent: 2f64.powf(self.velocity_curve.value() as f64),
         }
     }
@@ -146,6 +157,7 @@ impl RessortParams {
             }
         });
         let d = Controls::DEFAULT;
+        let voices_store = model.clone();
         RessortParams {
             model,
             cc_map: Arc::new(CcMap::default()),
@@ -170,6 +182,30 @@ impl RessortParams {
             model_edits: IntParam::new("Model Edits", 0, IntRange::Linear { min: 0, max: 255 })
                 .hide()
                 .non_automatable(),
+            voices: {
+                let store = voices_store;
+                IntParam::new(
+                    "Voices",
+                    1,
+                    IntRange::Linear {
+                        min: 1,
+                        max: MAX_VOICES as i32,
+                    },
+                )
+                .non_automatable()
+                .with_callback(Arc::new(move |v| store.set_voices(v.max(1) as usize)))
+            },
+            release: FloatParam::new(
+                "Release",
+                d.release as f32,
+                FloatRange::Linear { min: 0.0, max: 1.0 },
+            )
+            .with_unit(" %")
+            .with_value_to_string(Arc::new(|v| format!("{:.0}", v * 100.0)))
+            .with_string_to_value(Arc::new(|t| {
+                let t = t.trim().trim_end_matches('%').trim();
+                t.parse::<f32>().ok().map(|v| (v / 100.0).clamp(0.0, 1.0))
+            })),
             bend_range: FloatParam::new(
                 "Bend Range",
                 Controls::DEFAULT.bend_range_st as f32,

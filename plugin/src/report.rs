@@ -18,6 +18,8 @@ use std::sync::Mutex;
 pub enum MainThreadTask {
     /// The guard reset an exploding model: raise the `guard` parameter.
     ReportGuardTrip,
+    /// The Voices setting changed: re-prepare the running model with it.
+    ApplyVoices,
 }
 
 /// The editor's `GuiContext`, kept for main-thread parameter changes.

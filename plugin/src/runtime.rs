@@ -27,6 +27,9 @@ pub struct RuntimeStatus {
     pub strike_requested: AtomicBool,
     /// The editor's Audition switch: strike the note input every second.
     pub audition: AtomicBool,
+    /// Voices sounding, and the bank's size (1 and 1 when monophonic).
+    pub voices_sounding: AtomicU32,
+    pub voices_total: AtomicU32,
     /// The macro slot positions in use (a MIDI controller may have moved a slot away from its
     /// parameter's value).
     pub macros: [AtomicF64; crate::model::NUM_MACROS],
@@ -51,6 +54,8 @@ impl Default for RuntimeStatus {
             audition: AtomicBool::new(false),
             reset_requested: AtomicBool::new(false),
             macros: std::array::from_fn(|_| AtomicF64::new(0.5)),
+            voices_sounding: AtomicU32::new(1),
+            voices_total: AtomicU32::new(1),
         }
     }
 }

@@ -44,7 +44,9 @@ use clack_extensions::params::{
 };
 use clack_extensions::state::{HostState, HostStateImpl, PluginState, StateError};
 use clack_extensions::thread_check::{HostThreadCheck, HostThreadCheckImpl};
-use clack_host::events::event_types::{MidiEvent, NoteOffEvent, NoteOnEvent, ParamValueEvent};
+use clack_host::events::event_types::{
+    MidiEvent, NoteEndEvent, NoteOffEvent, NoteOnEvent, ParamValueEvent,
+};
 use clack_host::events::Match;
 use clack_host::host::HostError;
 use clack_host::prelude::*;
@@ -600,6 +602,17 @@ pub fn thread_count() -> usize {
 }
 
 /// Appends the parameter values among `events` to `into`.
+/// The keys of the CLAP note-end (voice terminated) events in `events`.
+fn collect_note_ends(events: &EventBuffer, into: &mut Vec<u16>) {
+    for event in events.iter() {
+        if let Some(e) = event.as_event::<NoteEndEvent>() {
+            if let Match::Specific(key) = e.key() {
+                into.push(key);
+            }
+        }
+    }
+}
+
 fn collect_param_values(events: &EventBuffer, into: &mut Vec<(ClapId, f64)>) {
     for event in events.iter() {
         if let Some(v) = event.as_event::<ParamValueEvent>() {
@@ -692,6 +705,8 @@ pub struct TestPlugin {
     /// Parameter values the plugin sent to the host (`CLAP_EVENT_PARAM_VALUE` in the output
     /// events of `process()` and `flush()`), in order.
     param_output: Vec<(ClapId, f64)>,
+    /// Keys of the voices the plugin reported ended (CLAP note-end events), in order.
+    note_ends: Vec<u16>,
     instance: PluginInstance<TestHost>,
 }
 
@@ -756,6 +771,7 @@ impl TestPlugin {
             io: None,
             ext,
             param_output: Vec::new(),
+            note_ends: Vec::new(),
             instance,
         };
         plugin.idle();
@@ -1183,6 +1199,7 @@ impl TestPlugin {
         });
         io.steady_time += n as u64;
         collect_param_values(&io.out_events, &mut self.param_output);
+        collect_note_ends(&io.out_events, &mut self.note_ends);
         match result {
             Ok(status) => status,
             Err(e) => panic!("process() failed: {e}"),
@@ -1343,6 +1360,11 @@ impl TestPlugin {
     }
 
     /// The parameter values the plugin has sent to the host since the last call.
+    /// The keys of the voices reported ended since the last call.
+    pub fn take_note_ends(&mut self) -> Vec<u16> {
+        std::mem::take(&mut self.note_ends)
+    }
+
     pub fn take_param_output(&mut self) -> Vec<(ClapId, f64)> {
         std::mem::take(&mut self.param_output)
     }

@@ -89,6 +89,8 @@ fn the_plugin_plays_what_the_instrument_plays() {
         (
             101,
             Event::NoteOn {
+                channel: 0,
+                voice_id: None,
                 note: 60,
                 velocity: 0.9,
             },
@@ -102,14 +104,25 @@ fn the_plugin_plays_what_the_instrument_plays() {
         (
             3_001,
             Event::NoteOn {
+                channel: 0,
+                voice_id: None,
                 note: 67,
                 velocity: 0.5,
             },
         ),
-        (4_000, Event::NoteOff { note: 60 }),
+        (
+            4_000,
+            Event::NoteOff {
+                channel: 0,
+                voice_id: None,
+                note: 60,
+            },
+        ),
         (
             12_345,
             Event::NoteOn {
+                channel: 0,
+                voice_id: None,
                 note: 55,
                 velocity: 1.0,
             },
@@ -257,7 +270,7 @@ fn a_learned_controller_moves_its_macro_like_the_knob() {
         .audio;
     let mut plain = plugin_with_model("small-mesh", SMALL_MESH, &[]);
     plain.activate(SR, 1, 512);
-    let untouched = plain.render_frames(frames, 512, &strike).audio;
+    let untouched = plain.render_frames(frames, 512, strike).audio;
     println!(
         "CC 74 → Macro 1: first difference from the knob {:?}, from the untouched model {:?}",
         by_cc.first_difference(&by_knob),

@@ -31,10 +31,14 @@ def shared_script(name: str) -> str:
 
 def model_state(name: str, script: str, params: dict | None = None) -> bytes:
     """A plugin state (nice-plug's JSON) that loads `script` as the running model and sets
-    the given float parameters (plain values by id); the others keep their defaults."""
+    the given parameters (plain values by id: an int for an integer parameter such as
+    `voices`, a float otherwise); the others keep their defaults."""
+    def value(v):
+        return {"i32": v} if isinstance(v, int) else {"f32": float(v)}
+
     state = {
         "version": "0.1.0",
-        "params": {id: {"f32": float(v)} for id, v in (params or {}).items()},
+        "params": {id: value(v) for id, v in (params or {}).items()},
         "fields": {"model": json.dumps({"name": name, "script": script})},
     }
     return json.dumps(state).encode()

@@ -6,9 +6,11 @@
 //! sin²(πf/SR) = K/4M (spec §5.3), see [`tuning_gain`].
 
 use super::dsp::{db_to_gain, tuning_gain, ChunkSmoother};
+use super::envelope::StabilityEnvelope;
+use super::macros::MacroBinding;
 use super::prepare::Prepared;
 use super::{CHUNK, NUM_MACROS};
-use crate::ScaleClass;
+use crate::{Engine, ScaleClass};
 
 /// Smoothing time constant of the physical controls.
 const CONTROL_SMOOTHING_MS: f64 = 15.0;
@@ -38,6 +40,9 @@ pub struct Controls {
     pub bend_range_st: f64,
     /// A note's strike is velocity^exponent (1: linear; above 1 soft notes are softer).
     pub velocity_exponent: f64,
+    /// The damper a released voice gets, 0 … 1: its Damping gain × 16^release (0: it rings
+    /// on as a struck object does).
+    pub release: f64,
 }
 
 impl Controls {
@@ -53,6 +58,7 @@ impl Controls {
         dc_filter: true,
         bend_range_st: 2.0,
         velocity_exponent: 1.0,
+        release: 0.0,
     };
 
     /// The smoothed controls as numbers, to notice automation between blocks. Non-finite
@@ -72,6 +78,8 @@ impl Controls {
         fix(&mut self.position_db, d.position_db);
         fix(&mut self.bend_range_st, d.bend_range_st);
         fix(&mut self.velocity_exponent, d.velocity_exponent);
+        fix(&mut self.release, d.release);
+        self.release = self.release.clamp(0.0, 1.0);
         for m in &mut self.macros {
             fix(m, 0.5);
         }
@@ -155,17 +163,22 @@ impl Smoothed {
     /// and the macro envelopes of the slots that moved. `note_st` is the note's distance
     /// from the reference key in semitones.
     pub fn apply(&self, model: &mut Prepared, note_st: f64) -> Gains {
+        let gains = self.gains(&ClampView::of(model), note_st, 1.0);
+        self.set(&mut model.engine, &model.macros, &gains);
+        gains
+    }
+
+    /// The clamped Stiffness and Damping gains for a note `note_st` semitones from the
+    /// reference key, with the Damping gain asked for multiplied by `z_factor` (the Release
+    /// damper of a released voice).
+    pub fn gains(&self, view: &ClampView<'_>, note_st: f64, z_factor: f64) -> Gains {
         let semitones = self.tune.value + note_st;
-        let tuning = tuning_gain(
-            semitones,
-            model.settings.reference_pitch_hz,
-            model.sample_rate,
-        );
+        let tuning = tuning_gain(semitones, view.reference_pitch_hz, view.sample_rate);
         let requested_k = 2f64.powf(self.stiffness.value) * tuning;
-        let requested_z = 2f64.powf(self.damping.value);
-        let mut moved = [(&model.envelope, 0.0); NUM_MACROS];
+        let requested_z = 2f64.powf(self.damping.value) * z_factor;
+        let mut moved = [(view.envelope, 0.0); NUM_MACROS];
         let mut n_moved = 0;
-        for (slot, (binding, envs)) in model.macros.iter().zip(&model.macro_envelopes).enumerate() {
+        for (slot, (binding, envs)) in view.macros.iter().zip(view.macro_envelopes).enumerate() {
             if let (Some(b), Some((low, high))) = (binding, envs) {
                 let v = b.value_at(self.macros[slot].value);
                 let (env, f) = if v > b.default && b.max > b.default {
@@ -179,27 +192,51 @@ impl Smoothed {
                 n_moved += 1;
             }
         }
-        let (gk, gz, clamped) = model.envelope.clamp_moved(
+        let (gk, gz, clamped) = view.envelope.clamp_moved(
             requested_k,
             requested_z,
             KEPT_STIFFNESS_GAIN,
             &moved[..n_moved],
         );
-        model.engine.set_class_gain(ScaleClass::Stiffness, gk);
-        model.engine.set_class_gain(ScaleClass::Damping, gz);
-        for (slot, binding) in model.macros.iter().enumerate() {
-            if let Some(b) = binding {
-                let _ = model
-                    .engine
-                    .set_param(b.param, b.value_at(self.macros[slot].value));
-            }
-        }
         Gains {
             stiffness: gk,
             damping: gz,
             requested_stiffness: requested_k,
             requested_damping: requested_z,
             clamped,
+        }
+    }
+
+    /// Puts `gains` and the macro values on one engine (the model's, or a voice's).
+    pub fn set(&self, engine: &mut Engine, macros: &[Option<MacroBinding>], gains: &Gains) {
+        engine.set_class_gain(ScaleClass::Stiffness, gains.stiffness);
+        engine.set_class_gain(ScaleClass::Damping, gains.damping);
+        for (slot, binding) in macros.iter().enumerate() {
+            if let Some(b) = binding {
+                let _ = engine.set_param(b.param, b.value_at(self.macros[slot].value));
+            }
+        }
+    }
+}
+
+/// What the stability clamp reads of a prepared model.
+#[derive(Clone, Copy, Debug)]
+pub struct ClampView<'a> {
+    pub reference_pitch_hz: Option<f64>,
+    pub sample_rate: f64,
+    pub envelope: &'a StabilityEnvelope,
+    pub macros: &'a [Option<MacroBinding>],
+    pub macro_envelopes: &'a [Option<(StabilityEnvelope, StabilityEnvelope)>],
+}
+
+impl<'a> ClampView<'a> {
+    pub fn of(m: &'a Prepared) -> ClampView<'a> {
+        ClampView {
+            reference_pitch_hz: m.settings.reference_pitch_hz,
+            sample_rate: m.sample_rate,
+            envelope: &m.envelope,
+            macros: &m.macros,
+            macro_envelopes: &m.macro_envelopes,
         }
     }
 }

@@ -6,10 +6,20 @@
 pub enum Event {
     /// A MIDI note: retunes the model to `note` (relative to the script's `~key`) from this
     /// sample on and strikes its note input with `velocity` (0 … 1) through the velocity
-    /// curve.
-    NoteOn { note: u8, velocity: f32 },
-    /// The end of a note. A struck model rings on.
-    NoteOff { note: u8 },
+    /// curve. With voices, it takes a voice of its own. `channel` (0 … 15) and the host's
+    /// `voice_id` identify the voice when it ends.
+    NoteOn {
+        note: u8,
+        velocity: f32,
+        channel: u8,
+        voice_id: Option<i32>,
+    },
+    /// The end of a note. A struck model rings on; with voices, its voice is released.
+    NoteOff {
+        note: u8,
+        channel: u8,
+        voice_id: Option<i32>,
+    },
     /// Pitch bend, 0 … 1 with 0.5 at rest; scaled by the bend range.
     PitchBend { value: f32 },
     /// A strike without retuning (the editor's Strike and Audition), `velocity` 0 … 1,
@@ -18,6 +28,27 @@ pub enum Event {
     /// A MIDI control change, `value` 0 … 1: it moves the macro slots mapped to `cc`
     /// ([`super::Instrument::set_cc_map`]) from this sample on, until the host moves them.
     Controller { cc: u8, value: f32 },
+}
+
+impl Event {
+    /// A note-on on channel 0 without a host voice id.
+    pub fn note_on(note: u8, velocity: f32) -> Event {
+        Event::NoteOn {
+            note,
+            velocity,
+            channel: 0,
+            voice_id: None,
+        }
+    }
+
+    /// A note-off on channel 0.
+    pub fn note_off(note: u8) -> Event {
+        Event::NoteOff {
+            note,
+            channel: 0,
+            voice_id: None,
+        }
+    }
 }
 
 /// An event at sample `timing` of the block being processed.

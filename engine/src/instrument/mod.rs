@@ -28,6 +28,7 @@ pub mod host;
 pub mod macros;
 pub mod output;
 pub mod prepare;
+pub mod voices;
 
 pub use controls::{Controls, Gains};
 pub use envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
@@ -37,8 +38,9 @@ pub use macros::MacroBinding;
 pub use prepare::{parse_script, peak_frequency, prepare, InputRole, Prepared, Rejected, Watcher};
 
 use crate::RouteSource;
-use controls::Smoothed;
+use controls::{ClampView, Smoothed};
 use output::{OutputStage, Span};
+pub use voices::{Ended, VoiceBank, VoiceState};
 
 /// The engine runs in chunks of at most this many samples; gains and macros are updated at
 /// chunk boundaries (counted from activation, so results do not depend on the host's block
@@ -55,6 +57,9 @@ pub const MAX_HOST_INPUTS: usize = 10;
 /// Host output channels the instrument writes: main left and right (`@out1`, `@out2`), then
 /// `@out3` … `@out8` on auxiliary outputs.
 pub const MAX_HOST_OUTPUTS: usize = 8;
+
+/// The sustain pedal's controller: it holds released voices.
+pub const SUSTAIN_CC: u8 = 64;
 
 /// Length of the crossfade from a replaced model to the new one.
 pub const SWAP_FADE_MS: f64 = 20.0;
@@ -219,6 +224,9 @@ impl Instrument {
     pub fn reset(&mut self, controls: Controls) -> Option<Box<Prepared>> {
         if let Some(m) = self.current.as_mut() {
             m.engine.reset();
+            if let Some(bank) = m.bank.as_mut() {
+                bank.clear();
+            }
         }
         self.fade_left = 0;
         self.note_st = 0.0;
@@ -241,14 +249,85 @@ impl Instrument {
     pub fn restart(&mut self) {
         if let Some(m) = self.current.as_mut() {
             m.engine.reset();
+            if let Some(bank) = m.bank.as_mut() {
+                bank.clear();
+            }
         }
         self.output.restart(self.sample_rate);
     }
 
-    /// Applies the smoothed controls to the running model.
+    /// Applies the smoothed controls to the running model: to its one engine, or to every
+    /// voice with the voice's own note (and the Release damper once its key is up).
     fn apply(&mut self) {
-        if let Some(m) = self.current.as_deref_mut() {
+        let Some(m) = self.current.as_deref_mut() else {
+            return;
+        };
+        let Some(bank) = m.bank.as_mut() else {
             self.gains = self.smoothed.apply(m, self.note_st);
+            return;
+        };
+        let view = ClampView {
+            reference_pitch_hz: m.settings.reference_pitch_hz,
+            sample_rate: m.sample_rate,
+            envelope: &m.envelope,
+            macros: &m.macros,
+            macro_envelopes: &m.macro_envelopes,
+        };
+        let release = 16f64.powf(self.controls.release);
+        let mut shown = self.smoothed.gains(&view, 0.0, 1.0);
+        let mut newest = 0;
+        for v in bank.voices.iter_mut() {
+            if v.state == VoiceState::Free {
+                continue;
+            }
+            let z = if v.state == VoiceState::Released {
+                release
+            } else {
+                1.0
+            };
+            let g = self.smoothed.gains(&view, v.note_st, z);
+            self.smoothed.set(&mut v.engine, view.macros, &g);
+            if v.started > newest {
+                newest = v.started;
+                shown = g;
+            }
+        }
+        self.gains = shown;
+    }
+
+    /// Tunes and sets up voice `i` of the bank for its note, before its first sample.
+    fn apply_voice(&mut self, i: usize) {
+        let Some(m) = self.current.as_deref_mut() else {
+            return;
+        };
+        let Some(bank) = m.bank.as_mut() else {
+            return;
+        };
+        let view = ClampView {
+            reference_pitch_hz: m.settings.reference_pitch_hz,
+            sample_rate: m.sample_rate,
+            envelope: &m.envelope,
+            macros: &m.macros,
+            macro_envelopes: &m.macro_envelopes,
+        };
+        let v = &mut bank.voices[i];
+        let g = self.smoothed.gains(&view, v.note_st, 1.0);
+        self.smoothed.set(&mut v.engine, view.macros, &g);
+        self.gains = g;
+    }
+
+    /// Voices sounding and the bank's size (1 and 1 without a bank).
+    pub fn voice_count(&self) -> (usize, usize) {
+        match self.current.as_deref().and_then(|m| m.bank.as_ref()) {
+            Some(b) => (b.sounding(), b.limit),
+            None => (1, 1),
+        }
+    }
+
+    /// Hands over the voices that ended (freed themselves or were stolen) since the last call.
+    pub fn drain_ended(&mut self, f: impl FnMut(Ended)) {
+        if let Some(b) = self.current.as_deref_mut().and_then(|m| m.bank.as_mut()) {
+            b.drain_ended(f);
         }
     }
 
@@ -314,13 +393,35 @@ impl Instrument {
             let mut retuned = false;
             while let Some(e) = next.filter(|e| at(e) <= pos) {
                 match e.event {
-                    Event::NoteOn { note, velocity } => {
-                        if let Some(m) = self.current.as_deref() {
-                            self.note_st = note as f64 - m.settings.reference_key;
-                            retuned = true;
-                        }
-                        strike +=
+                    Event::NoteOn {
+                        note,
+                        velocity,
+                        channel,
+                        voice_id,
+                    } => {
+                        let response =
                             events::velocity_response(velocity, self.controls.velocity_exponent);
+                        if let Some(m) = self.current.as_deref_mut() {
+                            let note_st = note as f64 - m.settings.reference_key;
+                            if let Some(bank) = m.bank.as_mut() {
+                                // A voice of its own, tuned before its first sample.
+                                let i = bank.note_on(note, channel, voice_id, note_st, response);
+                                self.apply_voice(i);
+                            } else {
+                                self.note_st = note_st;
+                                retuned = true;
+                                strike += response;
+                            }
+                        } else {
+                            strike += response;
+                        }
+                    }
+                    Event::NoteOff { note, channel, .. } => {
+                        if let Some(bank) =
+                            self.current.as_deref_mut().and_then(|m| m.bank.as_mut())
+                        {
+                            bank.note_off(note, channel);
+                        }
                     }
                     Event::Strike { velocity } => {
                         strike += events::velocity_response(velocity, 1.0);
@@ -331,7 +432,6 @@ impl Instrument {
                     Event::Controller { cc, value } => {
                         automated |= self.controller(cc, value);
                     }
-                    Event::NoteOff { .. } => {}
                 }
                 next = events.next();
             }
@@ -361,7 +461,7 @@ impl Instrument {
                     self.bend_st = events::bend_semitones(value, self.controls.bend_range_st);
                 }
                 Event::NoteOn { note, .. } => {
-                    if let Some(m) = self.current.as_deref() {
+                    if let Some(m) = self.current.as_deref().filter(|m| m.bank.is_none()) {
                         self.note_st = note as f64 - m.settings.reference_key;
                     }
                 }
@@ -383,6 +483,11 @@ impl Instrument {
         } else {
             return false;
         };
+        if cc == SUSTAIN_CC {
+            if let Some(bank) = self.current.as_deref_mut().and_then(|m| m.bank.as_mut()) {
+                bank.set_sustain(v >= 0.5);
+            }
+        }
         let mut moved = false;
         for slot in 0..NUM_MACROS {
             if self.cc_map[slot] == Some(cc) {
@@ -423,18 +528,37 @@ impl Instrument {
         let mut tripped = false;
         if let Some(m) = self.current.as_deref_mut() {
             m.fill_inputs(&self.host_in, self.order, len, force, position);
-            if strike > 0.0 {
-                m.strike(0, len, strike, force);
-            }
-            // The model.
             let n_in = m.roles.len();
             let n_out = m.outputs.len() / CHUNK;
-            let r = m
-                .engine
-                .process(len, &m.inputs[..n_in * len], &mut m.outputs[..n_out * len]);
-            tripped |= r.tripped;
-            if let Some(w) = m.watcher.as_mut() {
-                w.tick(len, m.engine.positions(), self.watching);
+            if let Some(bank) = m.bank.as_mut() {
+                // The voices, each with the host's inputs and its own strike.
+                let strike_force = m.settings.note_force * m.strike_scale * force;
+                tripped |= bank.process(
+                    len,
+                    &m.inputs[..n_in * len],
+                    &mut m.outputs[..n_out * len],
+                    m.note_input,
+                    strike_force,
+                );
+                bank.free_silent(len);
+                if let Some(w) = m.watcher.as_mut() {
+                    let positions = bank
+                        .newest()
+                        .map_or(m.engine.positions(), |v| v.engine.positions());
+                    w.tick(len, positions, self.watching);
+                }
+            } else {
+                if strike > 0.0 {
+                    m.strike(0, len, strike, force);
+                }
+                // The model.
+                let r =
+                    m.engine
+                        .process(len, &m.inputs[..n_in * len], &mut m.outputs[..n_out * len]);
+                tripped |= r.tripped;
+                if let Some(w) = m.watcher.as_mut() {
+                    w.tick(len, m.engine.positions(), self.watching);
+                }
             }
         }
         if let Some(old) = self.outgoing.as_deref_mut() {

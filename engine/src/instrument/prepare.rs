@@ -6,6 +6,7 @@
 use super::envelope::{envelope, raw_envelope, worst_load, StabilityEnvelope};
 use super::host::HostSettings;
 use super::macros::{macro_bindings, MacroBinding};
+use super::voices::VoiceBank;
 use super::CHUNK;
 use crate::{
     compile, parse, CompileOptions, Engine, InputUse, ModelSpec, RouteSource, SampleRateMode,
@@ -70,6 +71,9 @@ pub struct Prepared {
     pub worst_load: (f64, String),
     /// Sees the positions after every chunk, if set.
     pub watcher: Option<Box<dyn Watcher>>,
+    /// The voices when the model plays polyphonically ([`Prepared::set_voices`]); without
+    /// them `engine` is the one voice, and a note retunes it.
+    pub bank: Option<VoiceBank>,
 }
 
 /// Why a script did not become the running model: `LINE:COL: error: …` lines.
@@ -183,6 +187,7 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
     let num_outputs = info.num_outputs();
     Ok(Prepared {
         watcher: None,
+        bank: None,
         inputs: vec![0.0; roles.len() * CHUNK],
         outputs: vec![0.0; num_outputs.max(1) * CHUNK],
         num_outputs,
@@ -326,6 +331,32 @@ impl Prepared {
                 _ => dst.fill(rest),
             }
         }
+    }
+
+    /// Plays `voices` notes at once: 1 is the monophonic instrument (a note retunes and strikes
+    /// the one model); more make a voice bank of copies of the model. Allocates: call it off
+    /// the audio thread.
+    pub fn set_voices(&mut self, voices: usize) {
+        self.bank = (voices > 1).then(|| {
+            VoiceBank::new(
+                &self.engine,
+                self.roles.len(),
+                self.num_outputs,
+                voices,
+                self.sample_rate,
+            )
+        });
+    }
+
+    /// How many notes play at once.
+    pub fn voices(&self) -> usize {
+        self.bank.as_ref().map_or(1, |b| b.limit)
+    }
+
+    /// The force of a note's strike per unit of velocity response: the script's note force ×
+    /// the rate scale × `force` (the Force gain).
+    pub fn strike_force(&self, force: f64) -> f64 {
+        self.settings.note_force * self.strike_scale * force
     }
 
     /// Adds a one-sample strike of `velocity` (0 … 1) to the note input at `frame` of the

@@ -1,0 +1,374 @@
+//! The voice bank: polyphony as copies of one compiled model. Every voice has its own state,
+//! its own tuning (class gains) and strike, and shares the structure and the coefficients'
+//! expressions; the bank sums their outputs. Capacity is reserved when the model is prepared,
+//! so starting, stealing and freeing a voice never allocates.
+//!
+//! A note takes a free voice, resets it to the model's initial state (spec §1.5), tunes it to
+//! the note by the exact law and strikes it. When `limit` voices sound, the quietest one is
+//! stolen: it fades out over [`STEAL_FADE_MS`] in a spare slot while the new note starts at
+//! once. A voice frees itself when its motion has stayed below [`FREE_LEVEL`] for
+//! [`FREE_AFTER_MS`]: the largest distance of any point from its rest position or from its
+//! previous position — a state check, as mi-gen~'s Drunk Triangles does with the gap between
+//! its falling mass and the triangle, not an output level.
+
+use super::CHUNK;
+use crate::Engine;
+
+/// The fade-out of a stolen voice.
+pub const STEAL_FADE_MS: f64 = 5.0;
+/// Motion (model units) below which a voice counts as silent.
+pub const FREE_LEVEL: f64 = 1e-6;
+/// How long a voice must stay silent before it frees itself.
+pub const FREE_AFTER_MS: f64 = 250.0;
+
+/// What a voice is doing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VoiceState {
+    Free,
+    /// Its key is down (or the sustain pedal holds it).
+    Held,
+    /// Its key is up: it rings on, under the Release damper.
+    Released,
+    /// Stolen: fading out, then free.
+    Fading,
+}
+
+/// One copy of the model.
+#[derive(Clone, Debug)]
+pub struct Voice {
+    pub engine: Engine,
+    /// Planar scratch like the model's: inputs, then outputs, [`CHUNK`] samples per channel.
+    pub inputs: Vec<f64>,
+    pub outputs: Vec<f64>,
+    pub state: VoiceState,
+    pub note: u8,
+    pub channel: u8,
+    pub voice_id: Option<i32>,
+    /// Semitones from the reference key.
+    pub note_st: f64,
+    /// The key went up while the sustain pedal was down.
+    pub pedal_held: bool,
+    /// When it started, to tell old voices from new.
+    pub started: u64,
+    /// Samples spent below [`FREE_LEVEL`], and the last motion measured.
+    quiet: u64,
+    pub level: f64,
+    /// Output gain (1 but while fading) and its step per sample.
+    gain: f64,
+    fade_step: f64,
+    /// The strike (velocity response, 0 … 1) waiting for the voice's next span.
+    pub strike: f64,
+}
+
+/// A voice that ended, for the host (CLAP voice-terminated events).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Ended {
+    pub note: u8,
+    pub channel: u8,
+    pub voice_id: Option<i32>,
+}
+
+/// The voices of one prepared model.
+#[derive(Clone, Debug)]
+pub struct VoiceBank {
+    pub voices: Vec<Voice>,
+    /// How many voices may sound at once (the Voices setting); the rest of the capacity
+    /// holds stolen voices while they fade.
+    pub limit: usize,
+    /// Every point's position at rest.
+    rest: Vec<f64>,
+    clock: u64,
+    pub sustain: bool,
+    free_after: u64,
+    fade_step: f64,
+    /// Voices that ended since the host last asked, and how many of those did not fit.
+    ended: Vec<Ended>,
+    pub ended_dropped: u32,
+}
+
+impl VoiceBank {
+    /// `limit` voices of `template` (at rest), with room for stolen voices to fade, for
+    /// `n_in` inputs and `n_out` outputs. Allocates: call it off the audio thread.
+    pub fn new(
+        template: &Engine,
+        n_in: usize,
+        n_out: usize,
+        limit: usize,
+        sample_rate: f64,
+    ) -> VoiceBank {
+        let limit = limit.max(1);
+        let capacity = limit + (limit / 4).max(1);
+        let mut engine = template.clone();
+        engine.reset();
+        let rest = engine.positions().to_vec();
+        let voice = Voice {
+            engine,
+            inputs: vec![0.0; n_in * CHUNK],
+            outputs: vec![0.0; n_out.max(1) * CHUNK],
+            state: VoiceState::Free,
+            note: 0,
+            channel: 0,
+            voice_id: None,
+            note_st: 0.0,
+            pedal_held: false,
+            started: 0,
+            quiet: 0,
+            level: 0.0,
+            gain: 1.0,
+            fade_step: 0.0,
+            strike: 0.0,
+        };
+        VoiceBank {
+            voices: vec![voice; capacity],
+            limit,
+            rest,
+            clock: 0,
+            sustain: false,
+            free_after: (FREE_AFTER_MS * 1e-3 * sample_rate) as u64,
+            fade_step: 1.0 / (STEAL_FADE_MS * 1e-3 * sample_rate).max(1.0),
+            ended: Vec::with_capacity(capacity * 4),
+            ended_dropped: 0,
+        }
+    }
+
+    /// Voices that sound (held or released), not counting stolen ones fading out.
+    pub fn sounding(&self) -> usize {
+        self.voices
+            .iter()
+            .filter(|v| matches!(v.state, VoiceState::Held | VoiceState::Released))
+            .count()
+    }
+
+    /// The most recently started voice that is not free.
+    pub fn newest(&self) -> Option<&Voice> {
+        self.voices
+            .iter()
+            .filter(|v| v.state != VoiceState::Free)
+            .max_by_key(|v| v.started)
+    }
+
+    /// Starts a note: a free voice (the quietest sounding one is stolen when `limit` sound),
+    /// reset to rest, with `strike` waiting for its first sample. Returns the voice's index
+    /// so the caller can tune it. Realtime-safe.
+    pub fn note_on(
+        &mut self,
+        note: u8,
+        channel: u8,
+        voice_id: Option<i32>,
+        note_st: f64,
+        strike: f64,
+    ) -> usize {
+        if self.sounding() >= self.limit {
+            if let Some(victim) = self.quietest_sounding() {
+                self.steal(victim);
+            }
+        }
+        let slot = match self.voices.iter().position(|v| v.state == VoiceState::Free) {
+            Some(i) => i,
+            None => {
+                // Every spare slot is still fading: cut the one closest to silence.
+                let i = self
+                    .voices
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, v)| v.state == VoiceState::Fading)
+                    .min_by(|a, b| a.1.gain.total_cmp(&b.1.gain))
+                    .map(|(i, _)| i)
+                    .unwrap_or(0);
+                self.end(i);
+                i
+            }
+        };
+        self.clock += 1;
+        let v = &mut self.voices[slot];
+        v.engine.reset();
+        v.state = VoiceState::Held;
+        v.note = note;
+        v.channel = channel;
+        v.voice_id = voice_id;
+        v.note_st = note_st;
+        v.pedal_held = false;
+        v.started = self.clock;
+        v.quiet = 0;
+        v.level = f64::INFINITY;
+        v.gain = 1.0;
+        v.fade_step = 0.0;
+        v.strike = strike;
+        slot
+    }
+
+    /// A key went up: its held voices are released (held on while the pedal is down).
+    pub fn note_off(&mut self, note: u8, channel: u8) {
+        let sustain = self.sustain;
+        for v in self.voices.iter_mut() {
+            if v.state == VoiceState::Held && v.note == note && v.channel == channel {
+                if sustain {
+                    v.pedal_held = true;
+                } else {
+                    v.state = VoiceState::Released;
+                }
+            }
+        }
+    }
+
+    /// The sustain pedal (CC 64): up releases every voice it held.
+    pub fn set_sustain(&mut self, down: bool) {
+        self.sustain = down;
+        if !down {
+            for v in self.voices.iter_mut() {
+                if v.state == VoiceState::Held && v.pedal_held {
+                    v.pedal_held = false;
+                    v.state = VoiceState::Released;
+                }
+            }
+        }
+    }
+
+    /// Every voice silent and free at once (a reset).
+    pub fn clear(&mut self) {
+        for i in 0..self.voices.len() {
+            if self.voices[i].state != VoiceState::Free {
+                self.end(i);
+            }
+        }
+    }
+
+    fn quietest_sounding(&self) -> Option<usize> {
+        self.voices
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| matches!(v.state, VoiceState::Held | VoiceState::Released))
+            // Released voices go first, then the quietest, then the oldest.
+            .min_by(|a, b| {
+                let released = |v: &Voice| v.state != VoiceState::Released;
+                released(a.1)
+                    .cmp(&released(b.1))
+                    .then(a.1.level.total_cmp(&b.1.level))
+                    .then(a.1.started.cmp(&b.1.started))
+            })
+            .map(|(i, _)| i)
+    }
+
+    fn steal(&mut self, i: usize) {
+        let step = self.fade_step;
+        let v = &mut self.voices[i];
+        v.state = VoiceState::Fading;
+        v.fade_step = step;
+        self.push_ended(i);
+    }
+
+    /// Frees voice `i` now.
+    fn end(&mut self, i: usize) {
+        let was_fading = self.voices[i].state == VoiceState::Fading;
+        self.voices[i].state = VoiceState::Free;
+        self.voices[i].strike = 0.0;
+        if !was_fading {
+            // A stolen voice was reported when it was stolen.
+            self.push_ended(i);
+        }
+    }
+
+    fn push_ended(&mut self, i: usize) {
+        let v = &self.voices[i];
+        let e = Ended {
+            note: v.note,
+            channel: v.channel,
+            voice_id: v.voice_id,
+        };
+        if self.ended.len() < self.ended.capacity() {
+            self.ended.push(e);
+        } else {
+            self.ended_dropped += 1;
+        }
+    }
+
+    /// Hands over the voices that ended since the last call. Realtime-safe.
+    pub fn drain_ended(&mut self, mut f: impl FnMut(Ended)) {
+        for e in self.ended.drain(..) {
+            f(e);
+        }
+    }
+
+    /// Runs one span of `len` samples: every voice that is not free hears `inputs` (the
+    /// model's planar input scratch) plus its own strike, and the voices' outputs are summed
+    /// into `outputs` (planar, `n_out` channels). A strike enters the note input × `strike_force`.
+    /// Returns whether a voice's guard tripped (that voice is freed).
+    pub fn process(
+        &mut self,
+        len: usize,
+        inputs: &[f64],
+        outputs: &mut [f64],
+        note_input: Option<usize>,
+        strike_force: f64,
+    ) -> bool {
+        outputs.fill(0.0);
+        let mut tripped = false;
+        for i in 0..self.voices.len() {
+            if self.voices[i].state == VoiceState::Free {
+                continue;
+            }
+            let v = &mut self.voices[i];
+            let n_in = inputs.len() / len.max(1);
+            let vin = &mut v.inputs[..inputs.len()];
+            vin.copy_from_slice(inputs);
+            if v.strike != 0.0 {
+                if let Some(k) = note_input.filter(|k| *k < n_in) {
+                    vin[k * len] += v.strike * strike_force;
+                }
+                v.strike = 0.0;
+            }
+            let vout = &mut v.outputs[..outputs.len()];
+            let report = v.engine.process(len, vin, vout);
+            if report.tripped || v.engine.is_tripped() {
+                tripped = true;
+                self.end(i);
+                continue;
+            }
+            let v = &mut self.voices[i];
+            if v.state == VoiceState::Fading {
+                let n_out = outputs.len() / len.max(1);
+                for n in 0..len {
+                    v.gain -= v.fade_step;
+                    let g = v.gain.max(0.0);
+                    for c in 0..n_out {
+                        outputs[c * len + n] += v.outputs[c * len + n] * g;
+                    }
+                }
+                if v.gain <= 0.0 {
+                    self.voices[i].state = VoiceState::Free;
+                }
+            } else {
+                for (o, x) in outputs.iter_mut().zip(&v.outputs[..]) {
+                    *o += x;
+                }
+            }
+        }
+        tripped
+    }
+
+    /// Measures every sounding voice's motion after a span of `len` samples and frees the
+    /// ones that have stayed silent long enough. Realtime-safe.
+    pub fn free_silent(&mut self, len: usize) {
+        for i in 0..self.voices.len() {
+            let v = &mut self.voices[i];
+            if !matches!(v.state, VoiceState::Held | VoiceState::Released) {
+                continue;
+            }
+            let x = v.engine.positions();
+            let xp = v.engine.delayed_positions();
+            let mut level: f64 = 0.0;
+            for ((x, xp), r) in x.iter().zip(xp).zip(&self.rest) {
+                level = level.max((x - r).abs()).max((x - xp).abs());
+            }
+            v.level = level;
+            if level < FREE_LEVEL {
+                v.quiet += len as u64;
+                if v.quiet >= self.free_after {
+                    self.end(i);
+                }
+            } else {
+                v.quiet = 0;
+            }
+        }
+    }
+}

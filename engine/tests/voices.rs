@@ -1,0 +1,239 @@
+//! Polyphony in the instrument: every note its own copy of the model. A chord is the sum of
+//! its notes, a bank of one voice is the monophonic engine, voices free themselves at rest,
+//! stealing does not click, and the sustain pedal holds notes.
+
+use ressort_engine::instrument::{self, Controls, Event, Instrument, Timed, MAX_HOST_INPUTS};
+
+const SR: f64 = 48_000.0;
+
+/// An oscillator struck through a hammer (a contact: each voice is nonlinear on its own).
+const STRUCK: &str = "\
+@o osc 1. 0.02 0.0002 0. 0.
+@g ground 0.1
+@h mass 1. 0.1 0.
+@hs springDamper @g @h 0.0001 0.01
+@hit contact @o @h 0.1 0.001
+@in1 frcInput @h
+@out1 posOutput @o
+";
+
+/// A strongly damped oscillator struck directly: it comes to rest within a second.
+const DAMPED: &str = "\
+@o osc 1. 0.02 0.002 0. 0.
+@in1 frcInput @o
+@out1 posOutput @o
+";
+
+struct Render {
+    left: Vec<f32>,
+    ended: Vec<u8>,
+    sounding: Vec<usize>,
+}
+
+fn render(
+    script: &str,
+    voices: usize,
+    controls: Controls,
+    events: &[(u32, Event)],
+    frames: usize,
+) -> Render {
+    let mut model = instrument::prepare("test", script, SR).unwrap();
+    model.set_voices(voices);
+    let mut inst = Instrument::new(SR, controls);
+    inst.set_model(Box::new(model));
+    let block = 256;
+    let mut left = vec![0.0f32; frames];
+    let mut right = vec![0.0f32; frames];
+    let mut ended = Vec::new();
+    let mut sounding = Vec::new();
+    let mut start = 0;
+    while start < frames {
+        let n = block.min(frames - start);
+        let mut ev = events
+            .iter()
+            .filter(|(t, _)| (*t as usize) >= start && (*t as usize) < start + n)
+            .map(|&(t, e)| Timed::new(t - start as u32, e));
+        let host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+        let mut out: [&mut [f32]; 2] = [&mut left[start..start + n], &mut right[start..start + n]];
+        inst.process(n, &host, false, &mut ev, &controls, &mut out);
+        inst.drain_ended(|e| ended.push(e.note));
+        sounding.push(inst.voice_count().0);
+        start += n;
+    }
+    Render {
+        left,
+        ended,
+        sounding,
+    }
+}
+
+/// Below the soft ceiling and the DC filter's reach: the output stage is linear.
+fn quiet() -> Controls {
+    Controls {
+        output_db: -12.0,
+        ..Controls::DEFAULT
+    }
+}
+
+fn peak(x: &[f32]) -> f32 {
+    x.iter().fold(0.0f32, |m, v| m.max(v.abs()))
+}
+
+#[test]
+fn a_chord_is_the_sum_of_its_notes() {
+    let notes = [(0u32, 60u8), (12_000, 64), (24_001, 67)];
+    let frames = 48_000;
+    let chord: Vec<(u32, Event)> = notes
+        .iter()
+        .map(|&(t, n)| (t, Event::note_on(n, 0.9)))
+        .collect();
+    let together = render(STRUCK, 8, quiet(), &chord, frames).left;
+    let mut sum = vec![0.0f64; frames];
+    for &(t, n) in &notes {
+        let alone = render(STRUCK, 8, quiet(), &[(t, Event::note_on(n, 0.9))], frames).left;
+        for (s, x) in sum.iter_mut().zip(&alone) {
+            *s += *x as f64;
+        }
+    }
+    let p = peak(&together) as f64;
+    let err = together
+        .iter()
+        .zip(&sum)
+        .fold(0.0f64, |m, (a, b)| m.max((*a as f64 - b).abs()));
+    println!(
+        "chord peak {p:.4}, largest difference from the sum {err:.3e} ({:.2e} of the peak)",
+        err / p
+    );
+    assert!(
+        p > 1e-3 && p < 0.5,
+        "the chord must sound below the ceiling's knee ({p})"
+    );
+    assert!(err <= 1e-6 * p, "{err} > 1e-6 × {p}");
+}
+
+#[test]
+fn a_bank_of_one_note_plays_the_monophonic_engine() {
+    // One note from rest: a voice of the bank is the engine itself, to the bit.
+    let note = [(100u32, Event::note_on(60, 0.8))];
+    let mono = render(STRUCK, 1, quiet(), &note, 24_000).left;
+    let poly = render(STRUCK, 4, quiet(), &note, 24_000).left;
+    assert!(peak(&mono) > 1e-3);
+    assert_eq!(mono, poly);
+}
+
+#[test]
+fn voices_free_themselves_once_at_rest() {
+    let events: Vec<(u32, Event)> = (0..6)
+        .map(|i| (i * 2_400, Event::note_on(55 + i as u8, 1.0)))
+        .collect();
+    let r = render(DAMPED, 8, quiet(), &events, 3 * 48_000);
+    let most = r.sounding.iter().copied().max().unwrap();
+    println!(
+        "most voices sounding {most}; at the end {}; ended {:?}",
+        r.sounding.last().unwrap(),
+        r.ended
+    );
+    assert_eq!(most, 6);
+    assert_eq!(
+        *r.sounding.last().unwrap(),
+        0,
+        "every voice must free itself"
+    );
+    let mut ended = r.ended.clone();
+    ended.sort_unstable();
+    assert_eq!(ended, [55, 56, 57, 58, 59, 60], "each voice ends once");
+}
+
+#[test]
+fn stealing_a_voice_makes_no_click() {
+    // Two voices, three notes: the third steals the quieter of the first two, which fades out
+    // over 5 ms instead of stopping. The difference from a bank with room for all three is
+    // minus the stolen voice times (1 − its fade gain): it must change smoothly, where a cut
+    // would jump by the voice's whole value.
+    let events = [
+        (0u32, Event::note_on(60, 1.0)),
+        (4_800, Event::note_on(64, 1.0)),
+        (9_600, Event::note_on(67, 1.0)),
+    ];
+    let frames = 24_000;
+    let stolen = render(STRUCK, 2, quiet(), &events, frames);
+    let roomy = render(STRUCK, 3, quiet(), &events, frames);
+    assert_eq!(stolen.ended.len(), 1, "one voice was stolen");
+    assert!(stolen.sounding.iter().all(|&n| n <= 2));
+    let victim = stolen.ended[0];
+    let at = events
+        .iter()
+        .find(|(_, e)| *e == Event::note_on(victim, 1.0))
+        .unwrap()
+        .0;
+    let alone = render(
+        STRUCK,
+        3,
+        quiet(),
+        &[(at, Event::note_on(victim, 1.0))],
+        frames,
+    )
+    .left;
+    let d: Vec<f32> = stolen
+        .left
+        .iter()
+        .zip(&roomy.left)
+        .map(|(a, b)| a - b)
+        .collect();
+    let step = d.windows(2).fold(0.0f32, |m, w| m.max((w[1] - w[0]).abs()));
+    let level = peak(&alone[9_000..10_200]);
+    println!(
+        "note {victim} stolen; its level there {level:.3e}; largest step of the difference \
+         {step:.3e} ({:.1} % of it)",
+        100.0 * step / level
+    );
+    assert!(
+        level > 1e-3,
+        "the stolen voice must still sound when it is stolen"
+    );
+    assert!(step < 0.2 * level, "the stolen voice was cut, not faded");
+}
+
+#[test]
+fn release_damps_only_released_voices_and_the_pedal_holds_them() {
+    let controls = Controls {
+        release: 1.0,
+        ..quiet()
+    };
+    let held = render(STRUCK, 4, controls, &[(0, Event::note_on(60, 1.0))], 24_000).left;
+    let released = render(
+        STRUCK,
+        4,
+        controls,
+        &[(0, Event::note_on(60, 1.0)), (2_400, Event::note_off(60))],
+        24_000,
+    )
+    .left;
+    let pedalled = render(
+        STRUCK,
+        4,
+        controls,
+        &[
+            (0, Event::Controller { cc: 64, value: 1.0 }),
+            (0, Event::note_on(60, 1.0)),
+            (2_400, Event::note_off(60)),
+        ],
+        24_000,
+    )
+    .left;
+    let tail = |x: &[f32]| peak(&x[18_000..]);
+    println!(
+        "tail peak: held {:.3e}, released {:.3e}, released under the pedal {:.3e}",
+        tail(&held),
+        tail(&released),
+        tail(&pedalled)
+    );
+    assert!(
+        tail(&released) < 0.5 * tail(&held),
+        "Release must damp the released note"
+    );
+    assert_eq!(
+        held, pedalled,
+        "the pedal holds the note: nothing is released"
+    );
+}
