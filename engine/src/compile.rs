@@ -14,8 +14,11 @@ use crate::spec::{
     ElementKind, Endpoint, Law, MacroKind, MacroSpec, ModelSpec, ParamKind, SampleRateMode,
     ScaleClass, Span, Vector, REFERENCE_SAMPLE_RATE_HZ,
 };
+use label_map::LabelMap;
 use std::collections::HashMap;
 use std::fmt;
+
+pub(crate) mod label_map;
 
 /// The most material points a model may have (about 100 MB of state and scratch).
 pub const MAX_POINTS: usize = 1 << 20;
@@ -216,7 +219,7 @@ struct Row<'a> {
 /// Compile-time state.
 struct Cx<'a> {
     spec: &'a ModelSpec,
-    symbols: HashMap<&'a str, Symbol>,
+    symbols: LabelMap<&'a str, Symbol>,
     errors: Vec<CompileError>,
     program: Program,
     args: Vec<f64>,
@@ -302,6 +305,14 @@ impl<'a> Cx<'a> {
     /// Compiles `expr` into the program. Invalid expressions become NaN constants (the
     /// model is not built anyway, since an error was recorded).
     fn expr(&mut self, expr: &Expr, element: usize) -> (ExprRef, bool) {
+        if let Expr::Num(_) = expr {
+            // The commonest argument: nothing to check, resolve or mark audio-rate.
+            let r = self
+                .program
+                .push(expr, &|_| None)
+                .expect("a number names nothing");
+            return (r, false);
+        }
         let valid = self.check_expr(expr, element);
         let nan = Expr::Num(f64::NAN);
         let expr = if valid { expr } else { &nan };
@@ -516,7 +527,10 @@ impl<'a> Compiler<'a> {
         Compiler {
             cx: Cx {
                 spec,
-                symbols: HashMap::new(),
+                symbols: LabelMap::with_capacity_and_hasher(
+                    spec.params.len() + spec.elements.len(),
+                    Default::default(),
+                ),
                 errors: Vec::new(),
                 program: Program::default(),
                 args: Vec::new(),
@@ -549,7 +563,8 @@ impl<'a> Compiler<'a> {
         let mode = spec.sample_rate_mode;
 
         // Symbols: parameters and elements share one label space (spec §3.4).
-        let mut first_span: HashMap<&str, Span> = HashMap::new();
+        let mut first_span: LabelMap<&str, Span> =
+            LabelMap::with_capacity_and_hasher(self.symbols.capacity(), Default::default());
         for (id, p) in spec.params.iter().enumerate() {
             if let Some(&first) = first_span.get(p.name.as_str()) {
                 self.errors.push(CompileError {

@@ -17,8 +17,9 @@
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::lexer::is_blank;
+use crate::compile::label_map::LabelMap;
 use crate::expr::{BinOp, Expr, Func};
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 /// The deepest nesting (parentheses, calls, unary operators) and the deepest expression tree the
 /// front end accepts. Below the compiler's own limit of 256 (`compile::MAX_EXPR_DEPTH`).
@@ -69,7 +70,9 @@ pub(crate) struct Symbol {
 /// Every label of a script (spec §3.4), for name resolution and endpoint checks.
 #[derive(Debug, Default)]
 pub(crate) struct Symbols {
-    map: HashMap<String, Symbol>,
+    map: LabelMap<String, Symbol>,
+    /// Some label names a macro: only then can an endpoint be a legacy bare connection point.
+    has_macros: bool,
     /// Names of `~generate` directives that have an error: their labels are not known, so any
     /// `<name>_…` that is not declared otherwise resolves to [`SymKind::Unknown`] and
     /// references to it are not reported again (no cascades).
@@ -77,8 +80,12 @@ pub(crate) struct Symbols {
 }
 
 impl Symbols {
-    pub(crate) fn new() -> Symbols {
-        Symbols::default()
+    /// An empty table with room for `labels` labels.
+    pub(crate) fn with_capacity(labels: usize) -> Symbols {
+        Symbols {
+            map: LabelMap::with_capacity_and_hasher(labels, Default::default()),
+            ..Symbols::default()
+        }
     }
 
     /// The symbol named `name`: a declared label, or an unknown one under a broken generator.
@@ -104,7 +111,13 @@ impl Symbols {
     }
 
     pub(crate) fn insert(&mut self, name: String, symbol: Symbol) {
+        self.has_macros |= matches!(symbol.kind, SymKind::Macro { .. });
         self.map.insert(name, symbol);
+    }
+
+    /// True when some declared label names a macro.
+    pub(crate) fn has_macros(&self) -> bool {
+        self.has_macros
     }
 
     /// Records a `~generate` directive named `name` whose labels could not be worked out.
@@ -178,13 +191,24 @@ pub(crate) fn token_number_literal(t: &super::lexer::Token) -> Result<f64, Numbe
     if t.kind == super::lexer::TokKind::Bracket {
         Err(NumberError::Invalid)
     } else {
-        parse_number_literal(&t.text)
+        parse_number_literal(t.text)
     }
 }
 
 fn to_f64(chars: &[char]) -> Result<f64, NumberError> {
-    let s: String = chars.iter().collect();
-    match s.parse::<f64>() {
+    // Literals are ASCII and short: read them from the stack, not from a fresh String.
+    let mut buf = [0u8; 64];
+    let parsed = if chars.len() <= buf.len() && chars.iter().all(char::is_ascii) {
+        for (b, c) in buf.iter_mut().zip(chars) {
+            *b = *c as u8;
+        }
+        std::str::from_utf8(&buf[..chars.len()])
+            .map_err(|_| NumberError::Invalid)?
+            .parse::<f64>()
+    } else {
+        chars.iter().collect::<String>().parse::<f64>()
+    };
+    match parsed {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(NumberError::NonFinite),
         Err(_) => Err(NumberError::Invalid),
@@ -238,6 +262,9 @@ pub(crate) fn parse_expression(
     cx: &ExprContext<'_>,
     diags: &mut Diags,
 ) -> Option<Expr> {
+    if let Some(v) = plain_number(chars) {
+        return Some(Expr::Num(v));
+    }
     let toks = lex(chars, col, cx, diags)?;
     let mut p = ExprParser {
         toks,
@@ -258,6 +285,23 @@ pub(crate) fn parse_expression(
     } else {
         Some(e)
     }
+}
+
+/// The value of a signed number literal and nothing else (`0.1`, `-2e-3`): the commonest
+/// argument, read without the tokens and tree of the general parser. Gives what the parser
+/// gives (a sign before a literal folds into it, unary plus is dropped), and `None` for
+/// anything else, a non-finite literal included, which the parser then reads and reports.
+fn plain_number(chars: &[char]) -> Option<f64> {
+    let (negative, body) = match chars.split_first()? {
+        ('-', rest) => (true, rest),
+        ('+', rest) => (false, rest),
+        _ => (false, chars),
+    };
+    if scan_number(body, 0)? != body.len() {
+        return None;
+    }
+    let v = to_f64(body).ok()?;
+    Some(if negative { -v } else { v })
 }
 
 fn lex(
@@ -659,7 +703,7 @@ mod tests {
     use super::*;
 
     fn parse(s: &str) -> (Option<Expr>, Vec<Diagnostic>) {
-        let mut symbols = Symbols::new();
+        let mut symbols = Symbols::default();
         for n in ["a", "b", "kScale"] {
             symbols.insert(
                 n.to_string(),

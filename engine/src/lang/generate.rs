@@ -418,7 +418,7 @@ pub(crate) fn read(tokens: &[Token], line: u32, diags: &mut Diags, budget: &mut 
                 .filter(|g| g.kind != TokKind::Bare && g.col == end_col)
             {
                 value = Val {
-                    chars: g.text.clone(),
+                    chars: g.text.to_vec(),
                     col: g.inner_col,
                     bracket: g.kind == TokKind::Bracket,
                 };

@@ -100,6 +100,14 @@ fn shape_of(keyword: &str) -> Option<Shape> {
         .map(|(_, s)| *s)
 }
 
+/// [`shape_of`] a token's text, without making a string of it.
+fn shape_of_chars(keyword: &[char]) -> Option<Shape> {
+    KEYWORDS
+        .iter()
+        .find(|(k, _)| k.len() == keyword.len() && k.chars().eq(keyword.iter().copied()))
+        .map(|(_, s)| *s)
+}
+
 /// The accepted argument counts (after the keyword) and the signature for messages (§2.9).
 fn arity(shape: Shape) -> (usize, usize, &'static str) {
     use LawKind as L;
@@ -142,12 +150,12 @@ fn sym_kind(shape: Shape) -> SymKind {
 }
 
 /// A command or directive line, tokenised.
-struct Item {
+struct Item<'a> {
     line: u32,
     directive: bool,
     /// A command line with a lexical error: only its label token is kept, for pass 1.
     broken: bool,
-    tokens: Vec<Token>,
+    tokens: Vec<Token<'a>>,
     /// A `~generate` directive read in pass 1 and expanded in pass 2.
     generator: Option<Box<GenRequest>>,
     /// The name of a `~generate` line with a lexical error: its labels are unknown.
@@ -155,7 +163,7 @@ struct Item {
 }
 
 fn is_generate(item: &Item) -> bool {
-    item.directive && item.tokens.first().is_some_and(|t| t.text == GENERATE)
+    item.directive && item.tokens.first().is_some_and(|t| *t.text == GENERATE)
 }
 
 const GENERATE: [char; 9] = ['~', 'g', 'e', 'n', 'e', 'r', 'a', 't', 'e'];
@@ -168,15 +176,18 @@ pub fn parse(text: &str) -> Parsed {
 /// Parses script bytes: invalid UTF-8 is reported with its line and column (each invalid
 /// sequence reads as one U+FFFD character), and the rest is parsed as text (spec §3.12 f).
 pub fn parse_bytes(bytes: &[u8]) -> Parsed {
+    if let Ok(text) = std::str::from_utf8(bytes) {
+        return parse_with(text, Diags::default());
+    }
     let mut diags = Diags::default();
     let mut text = String::with_capacity(bytes.len());
     let mut pos = Position::default();
     for chunk in bytes.utf8_chunks() {
         let valid = chunk.valid();
         text.push_str(valid);
-        valid.chars().for_each(|c| pos.advance(c));
         let invalid = chunk.invalid();
         if !invalid.is_empty() {
+            valid.chars().for_each(|c| pos.advance(c));
             let hex: Vec<String> = invalid.iter().map(|b| format!("{b:02X}")).collect();
             diags.push(
                 Diagnostic::new(
@@ -230,16 +241,24 @@ impl Position {
 }
 
 fn parse_with(text: &str, mut diags: Diags) -> Parsed {
-    let mut items = Vec::new();
+    // Every line's characters in one buffer, which the tokens borrow.
+    let mut buffer: Vec<char> = Vec::with_capacity(text.len());
+    let mut lines = Vec::new();
     for (line, s) in split_lines(text) {
-        let chars: Vec<char> = s.chars().collect();
+        let start = buffer.len();
+        buffer.extend(s.chars());
+        lines.push((line, start..buffer.len()));
+    }
+    let mut items = Vec::with_capacity(lines.len());
+    for (line, range) in lines {
+        let chars = buffer.get(range).unwrap_or(&[]);
         let Some(first) = chars.iter().position(|c| !is_blank(*c)) else {
             continue;
         };
         match chars.get(first) {
             Some('@') | Some('~') => {
                 let directive = chars.get(first) == Some(&'~');
-                match tokenize(&chars, line, &mut diags) {
+                match tokenize(chars, line, &mut diags) {
                     Some(tokens) => items.push(Item {
                         line,
                         directive,
@@ -251,14 +270,14 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
                     None if !directive => {
                         // Keep the label known so references to it do not cascade: the line
                         // takes part in pass 1 with its label only (kind unknown).
-                        let label: Vec<char> = chars
+                        let rest = chars.get(first..).unwrap_or(&[]);
+                        let len = rest
                             .iter()
-                            .skip(first)
                             .take_while(|c| {
                                 !is_blank(**c) && !matches!(c, '+' | '[' | ']' | '\'' | '#')
                             })
-                            .copied()
-                            .collect();
+                            .count();
+                        let label = rest.get(..len).unwrap_or(&[]);
                         items.push(Item {
                             line,
                             directive: false,
@@ -296,12 +315,12 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
                 }
             }
             Some('#') => {}
-            _ => check_ignored_line(&chars, line, &mut diags),
+            _ => check_ignored_line(chars, line, &mut diags),
         }
     }
 
     // Pass 1: labels (spec §3.4), including those `~generate` creates (§4).
-    let mut symbols = Symbols::new();
+    let mut symbols = Symbols::with_capacity(items.len());
     let mut budget = MAX_GENERATED_ELEMENTS;
     for item in items.iter_mut() {
         if item.directive {
@@ -340,53 +359,51 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
             .tokens
             .get(1)
             .filter(|t| t.kind != TokKind::Bracket)
-            .and_then(|t| shape_of(&t.string()))
+            .and_then(|t| shape_of_chars(t.text))
             .map(sym_kind)
             .unwrap_or(SymKind::Unknown);
-        match symbols.declared(&label) {
-            Some(prev) => {
-                let message = if prev.generated {
-                    format!(
-                        "duplicate label `@{label}`: the `~generate` at line {} column {} \
-                         already creates it",
-                        prev.line, prev.col
-                    )
-                } else {
-                    format!(
-                        "duplicate label `@{label}`: already used at line {} column {} \
-                         (parameters and elements share one namespace)",
-                        prev.line, prev.col
-                    )
-                };
-                diags.push(
-                    Diagnostic::new(
-                        DiagnosticCode::DuplicateLabel,
-                        item.line,
-                        first.col,
-                        message,
-                    )
-                    .with_label(Some(&label)),
-                );
-            }
-            None => {
-                symbols.insert(
-                    label,
-                    Symbol {
-                        kind,
-                        line: item.line,
-                        col: first.col,
-                        generated: false,
-                    },
-                );
-            }
+        if let Some(prev) = symbols.declared(&label) {
+            let message = if prev.generated {
+                format!(
+                    "duplicate label `@{label}`: the `~generate` at line {} column {} \
+                     already creates it",
+                    prev.line, prev.col
+                )
+            } else {
+                format!(
+                    "duplicate label `@{label}`: already used at line {} column {} \
+                     (parameters and elements share one namespace)",
+                    prev.line, prev.col
+                )
+            };
+            diags.push(
+                Diagnostic::new(
+                    DiagnosticCode::DuplicateLabel,
+                    item.line,
+                    first.col,
+                    message,
+                )
+                .with_label(Some(&label)),
+            );
+            continue;
         }
+        let symbol = Symbol {
+            kind,
+            line: item.line,
+            col: first.col,
+            generated: false,
+        };
+        symbols.insert(label, symbol);
     }
 
     // Pass 2: directives and commands in script order.
     let mut b = Builder {
         diags,
         symbols: &symbols,
-        spec: ModelSpec::default(),
+        spec: ModelSpec {
+            elements: Vec::with_capacity(items.len()),
+            ..ModelSpec::default()
+        },
         open: Vec::new(),
         buffer_ids: HashMap::new(),
         samplerate: None,
@@ -979,13 +996,13 @@ impl Builder<'_> {
             );
             return;
         };
-        let keyword = kw.string();
         let shape = if kw.kind == TokKind::Bracket {
             None
         } else {
-            shape_of(&keyword)
+            shape_of_chars(kw.text)
         };
         let Some(shape) = shape else {
+            let keyword = kw.string();
             let mut d = at.diag(
                 DiagnosticCode::UnknownKeyword,
                 kw.col,
@@ -1029,7 +1046,7 @@ impl Builder<'_> {
             None => (args, &[][..]),
         };
         if args.len() < min || args.len() > max {
-            self.report_count(shape, &keyword, kw, args, (min, max, signature), at);
+            self.report_count(shape, &kw.string(), kw, args, (min, max, signature), at);
             return;
         }
         let kind = match shape {
@@ -1066,13 +1083,13 @@ impl Builder<'_> {
     /// three tokens more than an accepted argument count, the third from the end a bare name
     /// that is not a declared parameter. Returns the arguments without the tag (or `None` when
     /// the tag's coordinates are not numbers, which is reported).
-    fn split_tag<'t>(
+    fn split_tag<'t, 'c>(
         &mut self,
-        args: &'t [Token],
+        args: &'t [Token<'c>],
         min: usize,
         max: usize,
         at: At<'_>,
-    ) -> (Option<&'t [Token]>, Option<Tag>) {
+    ) -> (Option<&'t [Token<'c>]>, Option<Tag>) {
         let n = args.len();
         if n < 3 || !(min..=max).contains(&(n - 3)) {
             return (Some(args), None);
@@ -1223,7 +1240,7 @@ impl Builder<'_> {
             line: at.line,
             label: at.label,
         };
-        parse_expression(&t.text, t.inner_col, &cx, &mut self.diags)
+        parse_expression(t.text, t.inner_col, &cx, &mut self.diags)
     }
 
     /// An expression in an item of a vector or connection bracket.
@@ -1246,7 +1263,7 @@ impl Builder<'_> {
         if t.kind != TokKind::Bracket || t.text.iter().find(|c| !is_blank(**c)) == Some(&'@') {
             return self.expr(t, at).map(Vector::Scalar);
         }
-        let items = split_items(&t.text);
+        let items = split_items(t.text);
         match items.as_slice() {
             [one] => self.item_expr(t, *one, at).map(Vector::Scalar),
             [x, y, z] => {
@@ -1383,7 +1400,7 @@ impl Builder<'_> {
     }
 
     fn connection_point(&mut self, t: &Token, at: At<'_>) -> Option<Endpoint> {
-        let items = split_items(&t.text);
+        let items = split_items(t.text);
         let &(s, e) = items.first()?;
         let target: String = t.text.get(s + 1..e).unwrap_or(&[]).iter().collect();
         let target_col = t

@@ -59,7 +59,7 @@ impl Builder<'_> {
             let swapped = args.len() == 2
                 && args[1].kind == TokKind::Bare
                 && args[1].text.first() == Some(&'@')
-                && parse_number_literal(&v.text).is_ok();
+                && parse_number_literal(v.text).is_ok();
             let message = if swapped {
                 format!(
                     "`audioParam` takes its input first and its default after it: write `{} {}`",
