@@ -1,7 +1,7 @@
 //! Compiles a [`ModelSpec`] for one sample rate into an [`Engine`]. Runs off the audio thread;
 //! every problem is collected in one go (spec §3.12 f).
 //!
-//! The compiler is a sequence of named passes over the spec, sharing one state ([`Cx`], in
+//! The compiler is a sequence of named passes over the spec, sharing one state (`Cx`, in
 //! `context`):
 //!
 //! 1. **resolve labels** (`labels`): the symbol table of parameters and elements, and the

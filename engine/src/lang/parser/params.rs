@@ -1,7 +1,8 @@
 //! `param` and `audioParam` commands (spec §3.8): the parameter name, a control parameter's
 //! value, and an audio-rate parameter's input and optional default.
 
-use super::{At, Builder, Shape};
+use super::keywords::Shape;
+use super::{At, Builder};
 use crate::expr::Func;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::expr_parser::{
