@@ -18,13 +18,19 @@ use crate::info::{InputUse, OutputUse};
 use crate::spec::{ElementKind, Endpoint, Law};
 
 /// A link (an interaction element) of one law: its two points and its argument expressions,
-/// in the law's column order.
+/// in the law's column order (the first `LAW_COLUMNS[group]` of `args`).
 pub(super) struct Row<'a> {
     pub a: u32,
     pub b: u32,
-    pub args: Vec<(&'a Expr, ArgClass)>,
+    pub args: LawArgs<'a>,
     pub element: usize,
 }
+
+/// The most argument columns a law has.
+const MAX_LAW_COLUMNS: usize = 5;
+
+/// A law's argument expressions and their classes, padded with zeros to [`MAX_LAW_COLUMNS`].
+pub(super) type LawArgs<'a> = [(&'a Expr, ArgClass); MAX_LAW_COLUMNS];
 
 /// The number of interaction groups, one per law family, in [`law_row`] order.
 pub(super) const NUM_LAW_GROUPS: usize = 8;
@@ -220,27 +226,28 @@ impl<'a> Cx<'a> {
 }
 
 /// The interaction group index and argument list of a law.
-fn law_row(law: &Law) -> (usize, Vec<(&Expr, ArgClass)>) {
+fn law_row(law: &Law) -> (usize, LawArgs<'_>) {
     use ArgClass::{Damping as Z, None as N, Stiffness as K, VelocityScale as V};
     static ZERO: Expr = Expr::Num(0.0);
     let zero = &ZERO;
+    let pad = (zero, N);
     match law {
-        Law::Spring { k } => (0, vec![(k, K), (zero, Z)]),
-        Law::Damper { z } => (0, vec![(zero, K), (z, Z)]),
-        Law::SpringDamper { k, z } => (0, vec![(k, K), (z, Z)]),
-        Law::Contact { k, z, thresh } => (1, vec![(k, K), (z, Z), (thresh, N)]),
+        Law::Spring { k } => (0, [(k, K), (zero, Z), pad, pad, pad]),
+        Law::Damper { z } => (0, [(zero, K), (z, Z), pad, pad, pad]),
+        Law::SpringDamper { k, z } => (0, [(k, K), (z, Z), pad, pad, pad]),
+        Law::Contact { k, z, thresh } => (1, [(k, K), (z, Z), (thresh, N), pad, pad]),
         Law::NlContact {
             k,
             q,
             klim,
             z,
             thresh,
-        } => (2, vec![(k, K), (q, K), (klim, K), (z, Z), (thresh, N)]),
-        Law::NlSpring2 { k, q, z } => (3, vec![(k, K), (q, K), (z, Z)]),
-        Law::NlSpring3 { k, q, z } => (4, vec![(k, K), (q, K), (z, Z)]),
-        Law::NlSpringDamper { k, q, klim, z } => (5, vec![(k, K), (q, K), (klim, K), (z, Z)]),
-        Law::NlPluck { k, scale, z } => (6, vec![(k, K), (scale, N), (z, Z)]),
-        Law::NlBow { z, scale, smooth } => (7, vec![(z, Z), (scale, V), (smooth, N)]),
+        } => (2, [(k, K), (q, K), (klim, K), (z, Z), (thresh, N)]),
+        Law::NlSpring2 { k, q, z } => (3, [(k, K), (q, K), (z, Z), pad, pad]),
+        Law::NlSpring3 { k, q, z } => (4, [(k, K), (q, K), (z, Z), pad, pad]),
+        Law::NlSpringDamper { k, q, klim, z } => (5, [(k, K), (q, K), (klim, K), (z, Z), pad]),
+        Law::NlPluck { k, scale, z } => (6, [(k, K), (scale, N), (z, Z), pad, pad]),
+        Law::NlBow { z, scale, smooth } => (7, [(z, Z), (scale, V), (smooth, N), pad, pad]),
     }
 }
 

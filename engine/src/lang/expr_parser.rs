@@ -196,6 +196,9 @@ pub(crate) fn token_number_literal(t: &super::lexer::Token) -> Result<f64, Numbe
 }
 
 fn to_f64(chars: &[char]) -> Result<f64, NumberError> {
+    if let Some(v) = exact_decimal(chars) {
+        return Ok(v);
+    }
     // Literals are ASCII and short: read them from the stack, not from a fresh String.
     let mut buf = [0u8; 64];
     let parsed = if chars.len() <= buf.len() && chars.iter().all(char::is_ascii) {
@@ -213,6 +216,42 @@ fn to_f64(chars: &[char]) -> Result<f64, NumberError> {
         Ok(_) => Err(NumberError::NonFinite),
         Err(_) => Err(NumberError::Invalid),
     }
+}
+
+/// Powers of ten that are exact in f64.
+const EXACT_POWERS_OF_TEN: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// A literal `digits[.digits]` (no sign, no exponent) whose digits, read as an integer m, are at
+/// most 2^53, with at most 22 after the point: m and 10^f are then exact in f64, and one
+/// correctly rounded division gives the correctly rounded value, the same as `str::parse`
+/// (Clinger's fast path, which the standard library takes too). `None` for anything else.
+fn exact_decimal(chars: &[char]) -> Option<f64> {
+    let mut m: u64 = 0;
+    let mut digits = 0usize;
+    let mut frac: Option<usize> = None;
+    for &c in chars {
+        match c {
+            '0'..='9' => {
+                m = m
+                    .checked_mul(10)?
+                    .checked_add(u64::from(c) - u64::from('0'))?;
+                digits += 1;
+                if let Some(f) = frac.as_mut() {
+                    *f += 1;
+                }
+            }
+            '.' if frac.is_none() => frac = Some(0),
+            _ => return None,
+        }
+    }
+    if digits == 0 || m > 1 << 53 {
+        return None;
+    }
+    let power = EXACT_POWERS_OF_TEN.get(frac.unwrap_or(0))?;
+    Some(m as f64 / power)
 }
 
 /// A numeric literal with an optional sign, the only form allowed for `param` values and legacy
@@ -373,7 +412,7 @@ fn lex(
             {
                 i += 1;
             }
-            let name: String = chars.get(start..i).unwrap_or(&[]).iter().collect();
+            let name = super::lexer::text_of(chars.get(start..i).unwrap_or(&[]));
             toks.push((Tok::Ident(name), at));
         } else if matches!(c, '+' | '-' | '*' | '/' | '(' | ')' | ',') {
             toks.push((Tok::Op(c), at));
@@ -701,6 +740,57 @@ impl ExprParser<'_, '_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn exact_decimals_read_as_the_standard_parser_reads_them() {
+        let check = |text: &str| {
+            let chars: Vec<char> = text.chars().collect();
+            if let Some(v) = exact_decimal(&chars) {
+                let expected: f64 = text.parse().unwrap();
+                assert_eq!(v.to_bits(), expected.to_bits(), "{text}");
+            }
+        };
+        for text in [
+            "0",
+            "0.0",
+            "1.",
+            ".5",
+            "0.1",
+            "0.001",
+            "1.0",
+            "123.456",
+            "00012.5000",
+            "9007199254740992",
+            "9007199254740993",
+            "0.9007199254740992",
+            "0.0000000000000000000001",
+            "0.00000000000000000000001",
+            "18446744073709551616",
+        ] {
+            check(text);
+        }
+        assert_eq!(exact_decimal(&['.']), None);
+        assert_eq!(exact_decimal(&['1', 'e', '3']), None);
+        // Every length and point position, with digits from a fixed pseudo-random sequence.
+        let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+        for len in 1..=24 {
+            for point in 0..=len {
+                for _ in 0..40 {
+                    let mut text = String::new();
+                    for k in 0..len {
+                        if k == point {
+                            text.push('.');
+                        }
+                        seed ^= seed << 13;
+                        seed ^= seed >> 7;
+                        seed ^= seed << 17;
+                        text.push(char::from(b'0' + (seed % 10) as u8));
+                    }
+                    check(&text);
+                }
+            }
+        }
+    }
 
     fn parse(s: &str) -> (Option<Expr>, Vec<Diagnostic>) {
         let mut symbols = Symbols::default();

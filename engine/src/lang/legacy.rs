@@ -242,7 +242,7 @@ fn bare_label(t: &Token) -> Option<String> {
     if t.kind != TokKind::Bare || t.text.first() != Some(&'@') || t.text.len() < 2 {
         return None;
     }
-    Some(t.text.iter().skip(1).collect())
+    Some(t.label())
 }
 
 /// A token that can be a coordinate: a bare value (not a label) or a bracketed expression (not

@@ -65,9 +65,25 @@ pub(crate) struct Token<'a> {
     pub inner_col: u32,
 }
 
+/// The characters as a string. ASCII text, which nearly every label and number is, is copied
+/// byte for byte rather than encoded character by character.
+pub(crate) fn text_of(chars: &[char]) -> String {
+    if chars.iter().all(char::is_ascii) {
+        let bytes: Vec<u8> = chars.iter().map(|&c| c as u8).collect();
+        String::from_utf8(bytes).unwrap_or_default()
+    } else {
+        chars.iter().collect()
+    }
+}
+
 impl Token<'_> {
     pub(crate) fn string(&self) -> String {
-        self.text.iter().collect()
+        text_of(self.text)
+    }
+
+    /// The text after the first character: a label token's label, without its `@`.
+    pub(crate) fn label(&self) -> String {
+        text_of(self.text.get(1..).unwrap_or(&[]))
     }
 
     /// The token as written in the script, for messages.

@@ -23,7 +23,7 @@ impl Builder<'_> {
         let Some(first) = item.tokens.first() else {
             return;
         };
-        let label: String = first.text.iter().skip(1).collect();
+        let label = first.label();
         if label.is_empty() {
             return; // reported in pass 1
         }
@@ -218,7 +218,7 @@ impl Builder<'_> {
                 t.kind == TokKind::Bare
                     && t.text.first() == Some(&'@')
                     && matches!(
-                        self.symbols.get(&t.text.iter().skip(1).collect::<String>()),
+                        self.symbols.get(&t.label()),
                         Some(Symbol {
                             kind: SymKind::Macro { .. },
                             ..

@@ -26,7 +26,7 @@ impl Builder<'_> {
         let Some(first) = item.tokens.first() else {
             return;
         };
-        let name: String = first.text.iter().skip(1).collect();
+        let name = first.label();
         let args = item.tokens.get(1..).unwrap_or(&[]);
         let at = At {
             line: item.line,

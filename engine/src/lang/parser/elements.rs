@@ -79,16 +79,20 @@ impl Builder<'_> {
             Shape::Law(kind) => {
                 let a = self.slot_endpoint(args, 0, points, at);
                 let b = self.slot_endpoint(args, 1, points, at);
-                let params: Vec<Option<Expr>> = args
-                    .get(2..)
-                    .unwrap_or(&[])
-                    .iter()
-                    .map(|t| self.expr(t, at))
-                    .collect();
-                let (a, b) = (a?, b?);
-                let mut p: Vec<Expr> = params.into_iter().collect::<Option<Vec<Expr>>>()?;
-                // Optional trailing arguments default to 0 (spec §2.9).
                 let (_, max, _) = arity(shape);
+                let mut p: Vec<Expr> = Vec::with_capacity(max - 2);
+                let mut params_ok = true;
+                for t in args.get(2..).unwrap_or(&[]) {
+                    match self.expr(t, at) {
+                        Some(e) => p.push(e),
+                        None => params_ok = false,
+                    }
+                }
+                let (a, b) = (a?, b?);
+                if !params_ok {
+                    return None;
+                }
+                // Optional trailing arguments default to 0 (spec §2.9).
                 p.resize(max - 2, Expr::Num(0.0));
                 let law = make_law(kind, n - 2, p)?;
                 Some(ElementKind::Interaction { law, a, b })

@@ -6,7 +6,7 @@ use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::expr_parser::SymKind;
 use crate::lang::legacy;
-use crate::lang::lexer::{is_blank, split_items, TokKind, Token};
+use crate::lang::lexer::{is_blank, split_items, text_of, TokKind, Token};
 use crate::spec::Endpoint;
 
 impl Builder<'_> {
@@ -15,7 +15,7 @@ impl Builder<'_> {
     fn endpoint(&mut self, t: &Token, at: At<'_>) -> Option<Endpoint> {
         match t.kind {
             TokKind::Bare if t.text.first() == Some(&'@') => {
-                let name: String = t.text.iter().skip(1).collect();
+                let name = t.label();
                 if name.is_empty() {
                     self.diags.push(at.diag(
                         DiagnosticCode::BadLabel,
@@ -121,7 +121,7 @@ impl Builder<'_> {
     fn connection_point(&mut self, t: &Token, at: At<'_>) -> Option<Endpoint> {
         let items = split_items(t.text);
         let &(s, e) = items.first()?;
-        let target: String = t.text.get(s + 1..e).unwrap_or(&[]).iter().collect();
+        let target = text_of(t.text.get(s + 1..e).unwrap_or(&[]));
         let target_col = t
             .inner_col
             .saturating_add(u32::try_from(s).unwrap_or(u32::MAX));

@@ -33,7 +33,7 @@ pub(super) fn declare_labels(items: &mut [Item<'_>], diags: &mut Diags) -> Symbo
         let Some(first) = item.tokens.first() else {
             continue;
         };
-        let label: String = first.text.iter().skip(1).collect();
+        let label = first.label();
         if label.is_empty() {
             if item.broken {
                 continue; // the lexical error is enough
