@@ -19,6 +19,7 @@ use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::lexer::is_blank;
 use crate::compile::label_map::LabelMap;
 use crate::expr::{BinOp, Expr, Func};
+use std::collections::hash_map::Entry;
 use std::collections::HashSet;
 
 /// The deepest nesting (parentheses, calls, unary operators) and the deepest expression tree the
@@ -113,6 +114,19 @@ impl Symbols {
     pub(crate) fn insert(&mut self, name: String, symbol: Symbol) {
         self.has_macros |= matches!(symbol.kind, SymKind::Macro { .. });
         self.map.insert(name, symbol);
+    }
+
+    /// Declares `name` as `symbol`, unless it is declared already: then returns the name and
+    /// the earlier declaration.
+    pub(crate) fn declare(&mut self, name: String, symbol: Symbol) -> Result<(), (String, Symbol)> {
+        match self.map.entry(name) {
+            Entry::Occupied(prev) => Err((prev.key().clone(), *prev.get())),
+            Entry::Vacant(slot) => {
+                self.has_macros |= matches!(symbol.kind, SymKind::Macro { .. });
+                slot.insert(symbol);
+                Ok(())
+            }
+        }
     }
 
     /// True when some declared label names a macro.

@@ -53,7 +53,13 @@ pub(super) fn declare_labels(items: &mut [Item<'_>], diags: &mut Diags) -> Symbo
             .and_then(|t| shape_of_chars(t.text))
             .map(sym_kind)
             .unwrap_or(SymKind::Unknown);
-        if let Some(prev) = symbols.declared(&label) {
+        let symbol = Symbol {
+            kind,
+            line: item.line,
+            col: first.col,
+            generated: false,
+        };
+        if let Err((label, prev)) = symbols.declare(label, symbol) {
             let message = if prev.generated {
                 format!(
                     "duplicate label `@{label}`: the `~generate` at line {} column {} \
@@ -76,15 +82,7 @@ pub(super) fn declare_labels(items: &mut [Item<'_>], diags: &mut Diags) -> Symbo
                 )
                 .with_label(Some(&label)),
             );
-            continue;
         }
-        let symbol = Symbol {
-            kind,
-            line: item.line,
-            col: first.col,
-            generated: false,
-        };
-        symbols.insert(label, symbol);
     }
     symbols
 }
