@@ -74,8 +74,8 @@ pub fn compile(spec: &ModelSpec, options: &CompileOptions) -> Result<Engine, Com
     let rate = cx.rate(options);
     let params = cx.resolve_labels();
     let numbering = cx.number_points();
-    let kinds = cx.group_into_kinds(&params, numbering.len());
-    let bound = cx.bind_arguments(&kinds, rate);
+    let kinds = cx.group_into_kinds(&params, &numbering);
+    let bound = cx.bind_arguments(&kinds, &numbering, rate);
     cx.assemble(options, rate, params, numbering, kinds, bound)
 }
 

@@ -5,7 +5,7 @@
 
 use super::context::Cx;
 use super::kinds::{Kinds, LAW_COLUMNS};
-use super::points::fixed_nodes;
+use super::points::Numbering;
 use super::Rate;
 use crate::engine::{
     ArgClass, Group, InitRule, InitRun, Interactions, LineMacro, MacroSlots, Macros, MeshMacro,
@@ -26,10 +26,15 @@ pub(super) struct Bound {
 }
 
 impl<'a> Cx<'a> {
-    pub fn bind_arguments(&mut self, kinds: &Kinds<'a>, rate: Rate) -> Bound {
+    pub fn bind_arguments(
+        &mut self,
+        kinds: &Kinds<'a>,
+        numbering: &Numbering,
+        rate: Rate,
+    ) -> Bound {
         let mut init_runs = Vec::new();
         let (singles, audio_masses) = self.bind_singles(&kinds.singles, rate, &mut init_runs);
-        let macros = self.bind_macros(&kinds.macros, rate, &mut init_runs);
+        let macros = self.bind_macros(&numbering.macros, rate, &mut init_runs);
         for &(i, route) in &kinds.avatars {
             let ElementKind::PosInput { pos, .. } = &self.spec.elements[i].kind else {
                 continue;
@@ -150,14 +155,15 @@ impl<'a> Cx<'a> {
     /// Macros: five slots each (M, K, K2, Z, Zo) and one init run over their nodes.
     fn bind_macros(
         &mut self,
-        elements: &[usize],
+        elements: &[(usize, Vec<u32>)],
         rate: Rate,
         init_runs: &mut Vec<InitRun>,
     ) -> Macros {
         let mut macros = Macros::default();
         let mut largest_macro = 0;
         let zero = Expr::Num(0.0);
-        for &i in elements {
+        for (i, fixed) in elements {
+            let i = *i;
             let ElementKind::Macro(mac) = &self.spec.elements[i].kind else {
                 continue;
             };
@@ -203,7 +209,7 @@ impl<'a> Cx<'a> {
                         base: base_us,
                         length: mac.length as usize,
                         width: mac.width as usize,
-                        pinned: fixed_nodes(mac),
+                        pinned: fixed.clone(),
                         slots,
                     })
                 }

@@ -1,7 +1,7 @@
-//! Pass 3, group into kinds: sorts the elements into the engine's kinds (single masses, macros,
-//! avatars, one group per interaction law, inputs and outputs), resolving every endpoint and
-//! target to a point. A bracket endpoint creates a connection point, numbered after the
-//! material points in the order met. Nothing is bound here: the rows keep their argument
+//! Pass 3, group into kinds: sorts the elements into the engine's kinds (single masses, avatars,
+//! one group per interaction law, inputs and outputs; macros stay as numbered), resolving every
+//! endpoint and target to a point. A bracket endpoint creates a connection point, numbered after
+//! the material points in the order met. Nothing is bound here: the rows keep their argument
 //! expressions for the binding pass.
 //!
 //! Banding (issue 11, point 1) belongs here: [`LinkGroups`] is where the linear links, which
@@ -12,6 +12,7 @@
 use super::context::Cx;
 use super::errors::CompileErrorKind;
 use super::labels::Params;
+use super::points::Numbering;
 use crate::engine::{ArgClass, Route};
 use crate::expr::Expr;
 use crate::info::{InputUse, OutputUse};
@@ -79,8 +80,6 @@ impl Io {
 pub(super) struct Kinds<'a> {
     /// Single masses (mass, osc, ground, massG) that have a point, in script order.
     pub singles: Vec<usize>,
-    /// Macros that have points, in script order.
-    pub macros: Vec<usize>,
     /// Avatars with a valid channel: element and route.
     pub avatars: Vec<(usize, Route)>,
     pub links: LinkGroups<'a>,
@@ -92,20 +91,19 @@ pub(super) struct Kinds<'a> {
 }
 
 impl<'a> Cx<'a> {
-    pub fn group_into_kinds(&mut self, params: &Params, proxy_base: usize) -> Kinds<'a> {
+    pub fn group_into_kinds(&mut self, params: &Params, numbering: &Numbering) -> Kinds<'a> {
         let spec = self.spec;
+        let proxy_base = numbering.len();
         let has_point = |i: &usize| self.element_point[*i].is_some();
         let singles: Vec<usize> = (0..spec.elements.len())
             .filter(|&i| spec.elements[i].kind.is_single_mass())
             .filter(has_point)
             .collect();
-        let macros: Vec<usize> = (0..spec.elements.len())
-            .filter(|&i| matches!(spec.elements[i].kind, ElementKind::Macro(_)))
-            .filter(has_point)
-            .collect();
-        let mut num_interactions: usize = macros
+        // Macros stay as they are numbered (`Numbering::macros`); their links count here.
+        let mut num_interactions: usize = numbering
+            .macros
             .iter()
-            .map(|&i| match &spec.elements[i].kind {
+            .map(|&(i, _)| match &spec.elements[i].kind {
                 ElementKind::Macro(mac) => mac.num_links(),
                 _ => 0,
             })
@@ -215,7 +213,6 @@ impl<'a> Cx<'a> {
 
         Kinds {
             singles,
-            macros,
             avatars,
             links,
             io,

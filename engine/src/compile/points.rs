@@ -18,6 +18,8 @@ pub(super) struct Numbering {
     pub owner_element: Vec<usize>,
     /// The fixed nodes of every macro (spec §2.7), by point index.
     pub fixed_points: Vec<u32>,
+    /// The macros that have points, in script order: element index and local fixed nodes.
+    pub macros: Vec<(usize, Vec<u32>)>,
 }
 
 impl Numbering {
@@ -87,22 +89,26 @@ impl Cx<'_> {
             self.error(None, CompileErrorKind::TooLarge { points: total });
         }
 
-        // A macro's fixed nodes, in script order.
+        // The macros' fixed nodes, in script order.
         let mut fixed_points = Vec::new();
+        let mut macros = Vec::new();
         for (i, e) in spec.elements.iter().enumerate() {
             let (ElementKind::Macro(mac), Some(base)) = (&e.kind, self.element_point[i]) else {
                 continue;
             };
-            for p in fixed_nodes(mac) {
+            let fixed = fixed_nodes(mac);
+            for &p in &fixed {
                 fixed_points.push(base + p);
                 points[(base + p) as usize].kind = PointKind::MacroNode { fixed: true };
             }
+            macros.push((i, fixed));
         }
         Numbering {
             points,
             owners,
             owner_element,
             fixed_points,
+            macros,
         }
     }
 
@@ -130,8 +136,8 @@ impl Cx<'_> {
     }
 }
 
-/// The local indices of a macro's fixed nodes (spec §2.7).
-pub(super) fn fixed_nodes(mac: &MacroSpec) -> Vec<u32> {
+/// The local indices of a macro's fixed nodes (spec §2.7), in ascending order.
+fn fixed_nodes(mac: &MacroSpec) -> Vec<u32> {
     let (l, w) = (mac.length, mac.width);
     match mac.kind {
         MacroKind::String | MacroKind::StiffString => vec![0, l - 1],
@@ -141,11 +147,49 @@ pub(super) fn fixed_nodes(mac: &MacroSpec) -> Vec<u32> {
             v.dedup();
             v
         }
-        MacroKind::ClosedMesh => (0..l * w)
-            .filter(|n| {
-                let (i, j) = (n / w, n % w);
-                i == 0 || i == l - 1 || j == 0 || j == w - 1
-            })
-            .collect(),
+        // The border: the first and last rows whole, the ends of the rows between.
+        MacroKind::ClosedMesh => {
+            let mut v = Vec::with_capacity(2 * (l + w) as usize);
+            v.extend(0..w);
+            for i in 1..l.saturating_sub(1) {
+                v.extend([i * w, i * w + w - 1]);
+            }
+            if l > 1 {
+                v.extend((l - 1) * w..l * w);
+            }
+            v
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::expr::Expr;
+    use crate::spec::Vector;
+
+    #[test]
+    fn a_closed_mesh_is_fixed_on_its_border() {
+        for (l, w) in [(2, 2), (2, 5), (5, 2), (3, 3), (7, 4), (150, 150)] {
+            let mac = MacroSpec {
+                kind: MacroKind::ClosedMesh,
+                length: l,
+                width: w,
+                m: Expr::Num(1.0),
+                k: Expr::Num(0.1),
+                k2: None,
+                z: Expr::Num(0.0),
+                zo: Expr::Num(0.0),
+                pos: Vector::Scalar(Expr::Num(0.0)),
+                vel: Vector::Scalar(Expr::Num(0.0)),
+            };
+            let border: Vec<u32> = (0..l * w)
+                .filter(|n| {
+                    let (i, j) = (n / w, n % w);
+                    i == 0 || i == l - 1 || j == 0 || j == w - 1
+                })
+                .collect();
+            assert_eq!(fixed_nodes(&mac), border, "{l}×{w}");
+        }
     }
 }
