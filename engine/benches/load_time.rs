@@ -250,7 +250,9 @@ fn main() {
     for (file, limit) in LIMITS {
         if let Some(r) = rows.iter().find(|r| r.file == *file) {
             let verdict = if r.total_p90_ms < *limit {
-                format!("met, {:.0}× under the limit", limit / r.total_p90_ms)
+                let margin = limit / r.total_p90_ms;
+                let digits = if margin < 10.0 { 1 } else { 0 };
+                format!("met, {margin:.digits$}× under the limit")
             } else {
                 "NOT MET".to_string()
             };
