@@ -17,128 +17,13 @@
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::lexer::is_blank;
-use crate::compile::label_map::LabelMap;
+use super::numbers::{plain_number, scan_number, to_f64, NumberError};
+use super::symbols::{SymKind, Symbols};
 use crate::expr::{BinOp, Expr, Func};
-use std::collections::hash_map::Entry;
-use std::collections::HashSet;
 
 /// The deepest nesting (parentheses, calls, unary operators) and the deepest expression tree the
 /// front end accepts. Below the compiler's own limit of 256 (`compile::MAX_EXPR_DEPTH`).
 pub const MAX_NESTING: usize = 200;
-
-/// What a label names, for name resolution and endpoint checks (spec §3.4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum SymKind {
-    /// `param` or `audioParam`.
-    Param,
-    /// A mass-type element or an avatar: a valid endpoint.
-    Point,
-    /// A macro addressed with `dims` connection coordinates.
-    Macro {
-        dims: usize,
-    },
-    Interaction,
-    FrcInput,
-    Output,
-    /// A line whose keyword is unknown: references to it are not checked (no cascades).
-    Unknown,
-}
-
-impl SymKind {
-    pub(crate) fn describe(self) -> &'static str {
-        match self {
-            SymKind::Param => "a parameter",
-            SymKind::Point => "a point",
-            SymKind::Macro { .. } => "a macro",
-            SymKind::Interaction => "an interaction",
-            SymKind::FrcInput => "a force input",
-            SymKind::Output => "an output",
-            SymKind::Unknown => "an element of unknown type",
-        }
-    }
-}
-
-/// A declared label: what it names and where it was declared.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Symbol {
-    pub kind: SymKind,
-    pub line: u32,
-    pub col: u32,
-    /// Declared by a `~generate` directive (at `line:col`) rather than by a command.
-    pub generated: bool,
-}
-
-/// Every label of a script (spec §3.4), for name resolution and endpoint checks.
-#[derive(Debug, Default)]
-pub(crate) struct Symbols {
-    map: LabelMap<String, Symbol>,
-    /// Some label names a macro: only then can an endpoint be a legacy bare connection point.
-    has_macros: bool,
-    /// Names of `~generate` directives that have an error: their labels are not known, so any
-    /// `<name>_…` that is not declared otherwise resolves to [`SymKind::Unknown`] and
-    /// references to it are not reported again (no cascades).
-    broken_generators: HashSet<String>,
-}
-
-impl Symbols {
-    /// An empty table with room for `labels` labels.
-    pub(crate) fn with_capacity(labels: usize) -> Symbols {
-        Symbols {
-            map: LabelMap::with_capacity_and_hasher(labels, Default::default()),
-            ..Symbols::default()
-        }
-    }
-
-    /// The symbol named `name`: a declared label, or an unknown one under a broken generator.
-    pub(crate) fn get(&self, name: &str) -> Option<Symbol> {
-        if let Some(s) = self.map.get(name) {
-            return Some(*s);
-        }
-        let under_broken = name
-            .char_indices()
-            .filter(|&(_, c)| c == '_')
-            .any(|(i, _)| self.broken_generators.contains(name.get(..i).unwrap_or("")));
-        under_broken.then_some(Symbol {
-            kind: SymKind::Unknown,
-            line: 0,
-            col: 0,
-            generated: true,
-        })
-    }
-
-    /// The symbol declared as `name`, ignoring broken generators.
-    pub(crate) fn declared(&self, name: &str) -> Option<Symbol> {
-        self.map.get(name).copied()
-    }
-
-    pub(crate) fn insert(&mut self, name: String, symbol: Symbol) {
-        self.has_macros |= matches!(symbol.kind, SymKind::Macro { .. });
-        self.map.insert(name, symbol);
-    }
-
-    /// Declares `name` as `symbol`, unless it is declared already: then returns the name and
-    /// the earlier declaration.
-    pub(crate) fn declare(&mut self, name: String, symbol: Symbol) -> Result<(), (String, Symbol)> {
-        match self.map.entry(name) {
-            Entry::Occupied(prev) => Err((prev.key().clone(), *prev.get())),
-            Entry::Vacant(slot) => {
-                self.has_macros |= matches!(symbol.kind, SymKind::Macro { .. });
-                slot.insert(symbol);
-                Ok(())
-            }
-        }
-    }
-
-    /// True when some declared label names a macro.
-    pub(crate) fn has_macros(&self) -> bool {
-        self.has_macros
-    }
-
-    /// Records a `~generate` directive named `name` whose labels could not be worked out.
-    pub(crate) fn insert_broken_generator(&mut self, name: String) {
-        self.broken_generators.insert(name);
-    }
-}
 
 /// True for identifiers `[A-Za-z_][A-Za-z0-9_]*` (spec §3.4).
 pub(crate) fn is_identifier(s: &str) -> bool {
@@ -149,137 +34,6 @@ pub(crate) fn is_identifier(s: &str) -> bool {
 
 fn col_at(base: u32, i: usize) -> u32 {
     base.saturating_add(u32::try_from(i).unwrap_or(u32::MAX))
-}
-
-/// Scans the number grammar of spec §3.5 from `start`. Returns the end index, or `None` when no
-/// number starts there.
-fn scan_number(chars: &[char], start: usize) -> Option<usize> {
-    let digits = |mut j: usize| {
-        while chars.get(j).is_some_and(char::is_ascii_digit) {
-            j += 1;
-        }
-        j
-    };
-    let mut j = digits(start);
-    let int_digits = j - start;
-    let mut frac_digits = 0;
-    if chars.get(j) == Some(&'.') {
-        let k = digits(j + 1);
-        frac_digits = k - (j + 1);
-        j = k;
-    }
-    if int_digits == 0 && frac_digits == 0 {
-        return None;
-    }
-    if matches!(chars.get(j), Some('e' | 'E')) {
-        let mut k = j + 1;
-        if matches!(chars.get(k), Some('+' | '-')) {
-            k += 1;
-        }
-        if chars.get(k).is_some_and(char::is_ascii_digit) {
-            j = digits(k);
-        }
-    }
-    Some(j)
-}
-
-/// Why a literal was rejected.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum NumberError {
-    Invalid,
-    NonFinite,
-}
-
-impl NumberError {
-    /// The diagnostic category of the rejection.
-    pub(crate) fn code(self) -> DiagnosticCode {
-        match self {
-            NumberError::Invalid => DiagnosticCode::InvalidNumber,
-            NumberError::NonFinite => DiagnosticCode::NonFiniteNumber,
-        }
-    }
-}
-
-/// A token read as a numeric literal ([`parse_number_literal`]); a bracketed item never is one.
-pub(crate) fn token_number_literal(t: &super::lexer::Token) -> Result<f64, NumberError> {
-    if t.kind == super::lexer::TokKind::Bracket {
-        Err(NumberError::Invalid)
-    } else {
-        parse_number_literal(t.text)
-    }
-}
-
-fn to_f64(chars: &[char]) -> Result<f64, NumberError> {
-    if let Some(v) = exact_decimal(chars) {
-        return Ok(v);
-    }
-    // Literals are ASCII and short: read them from the stack, not from a fresh String.
-    let mut buf = [0u8; 64];
-    let parsed = if chars.len() <= buf.len() && chars.iter().all(char::is_ascii) {
-        for (b, c) in buf.iter_mut().zip(chars) {
-            *b = *c as u8;
-        }
-        std::str::from_utf8(&buf[..chars.len()])
-            .map_err(|_| NumberError::Invalid)?
-            .parse::<f64>()
-    } else {
-        chars.iter().collect::<String>().parse::<f64>()
-    };
-    match parsed {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(NumberError::NonFinite),
-        Err(_) => Err(NumberError::Invalid),
-    }
-}
-
-/// Powers of ten that are exact in f64.
-const EXACT_POWERS_OF_TEN: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
-    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
-];
-
-/// A literal `digits[.digits]` (no sign, no exponent) whose digits, read as an integer m, are at
-/// most 2^53, with at most 22 after the point: m and 10^f are then exact in f64, and one
-/// correctly rounded division gives the correctly rounded value, the same as `str::parse`
-/// (Clinger's fast path, which the standard library takes too). `None` for anything else.
-fn exact_decimal(chars: &[char]) -> Option<f64> {
-    let mut m: u64 = 0;
-    let mut digits = 0usize;
-    let mut frac: Option<usize> = None;
-    for &c in chars {
-        match c {
-            '0'..='9' => {
-                m = m
-                    .checked_mul(10)?
-                    .checked_add(u64::from(c) - u64::from('0'))?;
-                digits += 1;
-                if let Some(f) = frac.as_mut() {
-                    *f += 1;
-                }
-            }
-            '.' if frac.is_none() => frac = Some(0),
-            _ => return None,
-        }
-    }
-    if digits == 0 || m > 1 << 53 {
-        return None;
-    }
-    let power = EXACT_POWERS_OF_TEN.get(frac.unwrap_or(0))?;
-    Some(m as f64 / power)
-}
-
-/// A numeric literal with an optional sign, the only form allowed for `param` values and legacy
-/// tag coordinates (spec §3.5, §3.8, §6.4).
-pub(crate) fn parse_number_literal(chars: &[char]) -> Result<f64, NumberError> {
-    let (negative, body) = match chars.split_first() {
-        Some(('-', rest)) => (true, rest),
-        Some(('+', rest)) => (false, rest),
-        _ => (false, chars),
-    };
-    match scan_number(body, 0) {
-        Some(end) if end == body.len() => to_f64(body).map(|v| if negative { -v } else { v }),
-        _ => Err(NumberError::Invalid),
-    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -338,23 +92,6 @@ pub(crate) fn parse_expression(
     } else {
         Some(e)
     }
-}
-
-/// The value of a signed number literal and nothing else (`0.1`, `-2e-3`): the commonest
-/// argument, read without the tokens and tree of the general parser. Gives what the parser
-/// gives (a sign before a literal folds into it, unary plus is dropped), and `None` for
-/// anything else, a non-finite literal included, which the parser then reads and reports.
-fn plain_number(chars: &[char]) -> Option<f64> {
-    let (negative, body) = match chars.split_first()? {
-        ('-', rest) => (true, rest),
-        ('+', rest) => (false, rest),
-        _ => (false, chars),
-    };
-    if scan_number(body, 0)? != body.len() {
-        return None;
-    }
-    let v = to_f64(body).ok()?;
-    Some(if negative { -v } else { v })
 }
 
 fn lex(
@@ -754,57 +491,7 @@ impl ExprParser<'_, '_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn exact_decimals_read_as_the_standard_parser_reads_them() {
-        let check = |text: &str| {
-            let chars: Vec<char> = text.chars().collect();
-            if let Some(v) = exact_decimal(&chars) {
-                let expected: f64 = text.parse().unwrap();
-                assert_eq!(v.to_bits(), expected.to_bits(), "{text}");
-            }
-        };
-        for text in [
-            "0",
-            "0.0",
-            "1.",
-            ".5",
-            "0.1",
-            "0.001",
-            "1.0",
-            "123.456",
-            "00012.5000",
-            "9007199254740992",
-            "9007199254740993",
-            "0.9007199254740992",
-            "0.0000000000000000000001",
-            "0.00000000000000000000001",
-            "18446744073709551616",
-        ] {
-            check(text);
-        }
-        assert_eq!(exact_decimal(&['.']), None);
-        assert_eq!(exact_decimal(&['1', 'e', '3']), None);
-        // Every length and point position, with digits from a fixed pseudo-random sequence.
-        let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
-        for len in 1..=24 {
-            for point in 0..=len {
-                for _ in 0..40 {
-                    let mut text = String::new();
-                    for k in 0..len {
-                        if k == point {
-                            text.push('.');
-                        }
-                        seed ^= seed << 13;
-                        seed ^= seed >> 7;
-                        seed ^= seed << 17;
-                        text.push(char::from(b'0' + (seed % 10) as u8));
-                    }
-                    check(&text);
-                }
-            }
-        }
-    }
+    use crate::lang::symbols::Symbol;
 
     fn parse(s: &str) -> (Option<Expr>, Vec<Diagnostic>) {
         let mut symbols = Symbols::default();
@@ -859,16 +546,5 @@ mod tests {
         assert_eq!(parse(&long).1[0].code, DiagnosticCode::ExpressionTooDeep);
         let unary = "-".repeat(5000) + "a";
         assert_eq!(parse(&unary).1[0].code, DiagnosticCode::ExpressionTooDeep);
-    }
-
-    #[test]
-    fn literals() {
-        let l = |s: &str| parse_number_literal(&s.chars().collect::<Vec<_>>());
-        assert_eq!(l("-0.2"), Ok(-0.2));
-        assert_eq!(l("+3"), Ok(3.0));
-        assert_eq!(l("1e999"), Err(NumberError::NonFinite));
-        assert_eq!(l("1e"), Err(NumberError::Invalid));
-        assert_eq!(l("a"), Err(NumberError::Invalid));
-        assert_eq!(l(""), Err(NumberError::Invalid));
     }
 }

@@ -19,10 +19,10 @@
 //! once, when the script is read, and become the initial values of the generated parameters.
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
-use super::expr_parser::{
-    is_identifier, parse_expression, parse_number_literal, ExprContext, NumberError, Symbols,
-};
+use super::expr_parser::{is_identifier, parse_expression, ExprContext};
 use super::lexer::{is_blank, split_items, TokKind, Token};
+use super::numbers::{parse_number_literal, NumberError};
+use super::symbols::Symbols;
 use crate::generators::{
     generate, Fixed, Generator, GeneratorError, LatticeFixed, Topology, MAX_GENERATED_LINKS,
     MAX_GENERATED_NODES,

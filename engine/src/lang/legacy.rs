@@ -22,8 +22,8 @@
 //! arguments, and a bare macro label without coordinates is still an error.
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
-use super::expr_parser::{SymKind, Symbols};
 use super::lexer::{is_blank, TokKind, Token};
+use super::symbols::{SymKind, Symbols};
 
 /// A bare macro label in an endpoint slot, with the coordinate tokens that go with it.
 #[derive(Debug)]

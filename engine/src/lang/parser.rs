@@ -15,9 +15,9 @@
 //! * `keywords`: the type keywords and the argument shape each selects.
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
-use super::expr_parser::Symbols;
 use super::generate::{self, GenRequest};
 use super::lexer::split_lines;
+use super::symbols::Symbols;
 use super::Parsed;
 use crate::spec::{ModelSpec, SampleRateMode};
 use lines::is_generate;

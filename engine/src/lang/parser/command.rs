@@ -6,9 +6,11 @@ use super::keywords::{arity, shape_of_chars, Shape, KEYWORDS};
 use super::lines::Item;
 use super::{At, Builder};
 use crate::lang::diagnostics::DiagnosticCode;
-use crate::lang::expr_parser::{is_identifier, token_number_literal, SymKind, Symbol};
+use crate::lang::expr_parser::is_identifier;
 use crate::lang::legacy;
 use crate::lang::lexer::{TokKind, Token};
+use crate::lang::numbers::token_number_literal;
+use crate::lang::symbols::{SymKind, Symbol};
 use crate::spec::{Element, Span};
 
 /// A legacy trailing buffer tag `NAME x y` (spec §6.4).

@@ -4,8 +4,9 @@
 use super::lines::Item;
 use super::{At, Builder, MAX_OPEN_SCOPES};
 use crate::lang::diagnostics::{DiagnosticCode, Diags};
-use crate::lang::expr_parser::{is_identifier, SymKind};
+use crate::lang::expr_parser::is_identifier;
 use crate::lang::lexer::{TokKind, Token};
+use crate::lang::symbols::SymKind;
 use crate::spec::{MacroRange, Route, RouteSource, SampleRateMode};
 
 /// The highest model input a host directive may name.

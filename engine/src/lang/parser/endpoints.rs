@@ -4,9 +4,9 @@
 use super::{At, Builder};
 use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
-use crate::lang::expr_parser::SymKind;
 use crate::lang::legacy;
 use crate::lang::lexer::{is_blank, split_items, text_of, TokKind, Token};
+use crate::lang::symbols::SymKind;
 use crate::spec::Endpoint;
 
 impl Builder<'_> {

@@ -1,7 +1,7 @@
 //! The type keywords of spec §2.9 (with the legacy aliases of §3.12 a), the argument shape
 //! each selects, and the accepted argument counts.
 
-use crate::lang::expr_parser::SymKind;
+use crate::lang::symbols::SymKind;
 use crate::spec::MacroKind;
 
 /// The interaction laws, before their arguments are known.

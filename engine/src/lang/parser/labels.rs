@@ -3,9 +3,9 @@
 use super::keywords::{shape_of_chars, sym_kind};
 use super::lines::{is_generate, Item};
 use crate::lang::diagnostics::{Diagnostic, DiagnosticCode, Diags};
-use crate::lang::expr_parser::{SymKind, Symbol, Symbols};
 use crate::lang::generate::{self, GenRequest, Read, MAX_GENERATED_ELEMENTS};
 use crate::lang::lexer::TokKind;
+use crate::lang::symbols::{SymKind, Symbol, Symbols};
 
 /// Pass 1: every label (spec §3.4: names and elements may be used before their declaration
 /// line), those a `~generate` directive creates included (§4), with duplicates reported.

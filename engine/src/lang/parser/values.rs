@@ -4,8 +4,9 @@
 use super::{At, Builder, MAX_MACRO_NODES};
 use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
-use crate::lang::expr_parser::{parse_expression, ExprContext, SymKind};
+use crate::lang::expr_parser::{parse_expression, ExprContext};
 use crate::lang::lexer::{is_blank, split_items, TokKind, Token};
+use crate::lang::symbols::SymKind;
 use crate::spec::Vector;
 
 impl Builder<'_> {
