@@ -1,7 +1,7 @@
 //! Each element kind's arguments (spec §2.9): masses, interactions and their laws, macros,
 //! inputs and outputs.
 
-use super::keywords::{arity, LawKind, Shape};
+use super::keywords::{LawKind, Shape};
 use super::{At, Builder, MAX_MACRO_NODES};
 use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
@@ -79,12 +79,12 @@ impl Builder<'_> {
             Shape::Law(kind) => {
                 let a = self.slot_endpoint(args, 0, points, at);
                 let b = self.slot_endpoint(args, 1, points, at);
-                let (_, max, _) = arity(shape);
-                let mut p: Vec<Expr> = Vec::with_capacity(max - 2);
+                // Optional trailing arguments default to 0 (spec §2.9).
+                let mut p: [Expr; MAX_LAW_PARAMS] = std::array::from_fn(|_| Expr::Num(0.0));
                 let mut params_ok = true;
-                for t in args.get(2..).unwrap_or(&[]) {
+                for (slot, t) in p.iter_mut().zip(args.get(2..).unwrap_or(&[])) {
                     match self.expr(t, at) {
-                        Some(e) => p.push(e),
+                        Some(e) => *slot = e,
                         None => params_ok = false,
                     }
                 }
@@ -92,8 +92,6 @@ impl Builder<'_> {
                 if !params_ok {
                     return None;
                 }
-                // Optional trailing arguments default to 0 (spec §2.9).
-                p.resize(max - 2, Expr::Num(0.0));
                 let law = make_law(kind, n - 2, p)?;
                 Some(ElementKind::Interaction { law, a, b })
             }
@@ -183,9 +181,13 @@ impl Builder<'_> {
     }
 }
 
-/// Builds a law from its parameters (padded with 0 for optional ones); `given` is the number
-/// written, which selects the legacy two-parameter `spring` (= springDamper, spec §3.12 a).
-fn make_law(kind: LawKind, given: usize, p: Vec<Expr>) -> Option<Law> {
+/// The most parameters a law takes (`nlContact`: K, KnlQ, Klim, Z, thresh).
+const MAX_LAW_PARAMS: usize = 5;
+
+/// Builds a law from its parameters (0 for the optional ones not written, and in the slots past
+/// the law's own); `given` is the number written, which selects the legacy two-parameter
+/// `spring` (= springDamper, spec §3.12 a).
+fn make_law(kind: LawKind, given: usize, p: [Expr; MAX_LAW_PARAMS]) -> Option<Law> {
     let mut it = p.into_iter();
     let mut next = || it.next();
     Some(match kind {
