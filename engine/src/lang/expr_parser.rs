@@ -17,101 +17,13 @@
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::lexer::is_blank;
+use super::numbers::{plain_number, scan_number, to_f64, NumberError};
+use super::symbols::{SymKind, Symbols};
 use crate::expr::{BinOp, Expr, Func};
-use std::collections::{HashMap, HashSet};
 
 /// The deepest nesting (parentheses, calls, unary operators) and the deepest expression tree the
 /// front end accepts. Below the compiler's own limit of 256 (`compile::MAX_EXPR_DEPTH`).
 pub const MAX_NESTING: usize = 200;
-
-/// What a label names, for name resolution and endpoint checks (spec §3.4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum SymKind {
-    /// `param` or `audioParam`.
-    Param,
-    /// A mass-type element or an avatar: a valid endpoint.
-    Point,
-    /// A macro addressed with `dims` connection coordinates.
-    Macro {
-        dims: usize,
-    },
-    Interaction,
-    FrcInput,
-    Output,
-    /// A line whose keyword is unknown: references to it are not checked (no cascades).
-    Unknown,
-}
-
-impl SymKind {
-    pub(crate) fn describe(self) -> &'static str {
-        match self {
-            SymKind::Param => "a parameter",
-            SymKind::Point => "a point",
-            SymKind::Macro { .. } => "a macro",
-            SymKind::Interaction => "an interaction",
-            SymKind::FrcInput => "a force input",
-            SymKind::Output => "an output",
-            SymKind::Unknown => "an element of unknown type",
-        }
-    }
-}
-
-/// A declared label: what it names and where it was declared.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Symbol {
-    pub kind: SymKind,
-    pub line: u32,
-    pub col: u32,
-    /// Declared by a `~generate` directive (at `line:col`) rather than by a command.
-    pub generated: bool,
-}
-
-/// Every label of a script (spec §3.4), for name resolution and endpoint checks.
-#[derive(Debug, Default)]
-pub(crate) struct Symbols {
-    map: HashMap<String, Symbol>,
-    /// Names of `~generate` directives that have an error: their labels are not known, so any
-    /// `<name>_…` that is not declared otherwise resolves to [`SymKind::Unknown`] and
-    /// references to it are not reported again (no cascades).
-    broken_generators: HashSet<String>,
-}
-
-impl Symbols {
-    pub(crate) fn new() -> Symbols {
-        Symbols::default()
-    }
-
-    /// The symbol named `name`: a declared label, or an unknown one under a broken generator.
-    pub(crate) fn get(&self, name: &str) -> Option<Symbol> {
-        if let Some(s) = self.map.get(name) {
-            return Some(*s);
-        }
-        let under_broken = name
-            .char_indices()
-            .filter(|&(_, c)| c == '_')
-            .any(|(i, _)| self.broken_generators.contains(name.get(..i).unwrap_or("")));
-        under_broken.then_some(Symbol {
-            kind: SymKind::Unknown,
-            line: 0,
-            col: 0,
-            generated: true,
-        })
-    }
-
-    /// The symbol declared as `name`, ignoring broken generators.
-    pub(crate) fn declared(&self, name: &str) -> Option<Symbol> {
-        self.map.get(name).copied()
-    }
-
-    pub(crate) fn insert(&mut self, name: String, symbol: Symbol) {
-        self.map.insert(name, symbol);
-    }
-
-    /// Records a `~generate` directive named `name` whose labels could not be worked out.
-    pub(crate) fn insert_broken_generator(&mut self, name: String) {
-        self.broken_generators.insert(name);
-    }
-}
 
 /// True for identifiers `[A-Za-z_][A-Za-z0-9_]*` (spec §3.4).
 pub(crate) fn is_identifier(s: &str) -> bool {
@@ -122,87 +34,6 @@ pub(crate) fn is_identifier(s: &str) -> bool {
 
 fn col_at(base: u32, i: usize) -> u32 {
     base.saturating_add(u32::try_from(i).unwrap_or(u32::MAX))
-}
-
-/// Scans the number grammar of spec §3.5 from `start`. Returns the end index, or `None` when no
-/// number starts there.
-fn scan_number(chars: &[char], start: usize) -> Option<usize> {
-    let digits = |mut j: usize| {
-        while chars.get(j).is_some_and(char::is_ascii_digit) {
-            j += 1;
-        }
-        j
-    };
-    let mut j = digits(start);
-    let int_digits = j - start;
-    let mut frac_digits = 0;
-    if chars.get(j) == Some(&'.') {
-        let k = digits(j + 1);
-        frac_digits = k - (j + 1);
-        j = k;
-    }
-    if int_digits == 0 && frac_digits == 0 {
-        return None;
-    }
-    if matches!(chars.get(j), Some('e' | 'E')) {
-        let mut k = j + 1;
-        if matches!(chars.get(k), Some('+' | '-')) {
-            k += 1;
-        }
-        if chars.get(k).is_some_and(char::is_ascii_digit) {
-            j = digits(k);
-        }
-    }
-    Some(j)
-}
-
-/// Why a literal was rejected.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum NumberError {
-    Invalid,
-    NonFinite,
-}
-
-impl NumberError {
-    /// The diagnostic category of the rejection.
-    pub(crate) fn code(self) -> DiagnosticCode {
-        match self {
-            NumberError::Invalid => DiagnosticCode::InvalidNumber,
-            NumberError::NonFinite => DiagnosticCode::NonFiniteNumber,
-        }
-    }
-}
-
-/// A token read as a numeric literal ([`parse_number_literal`]); a bracketed item never is one.
-pub(crate) fn token_number_literal(t: &super::lexer::Token) -> Result<f64, NumberError> {
-    if t.kind == super::lexer::TokKind::Bracket {
-        Err(NumberError::Invalid)
-    } else {
-        parse_number_literal(&t.text)
-    }
-}
-
-fn to_f64(chars: &[char]) -> Result<f64, NumberError> {
-    let s: String = chars.iter().collect();
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(NumberError::NonFinite),
-        Err(_) => Err(NumberError::Invalid),
-    }
-}
-
-/// A numeric literal with an optional sign, the only form allowed for `param` values and legacy
-/// tag coordinates (spec §3.5, §3.8, §6.4).
-pub(crate) fn parse_number_literal(chars: &[char]) -> Result<f64, NumberError> {
-    let (negative, body) = match chars.split_first() {
-        Some(('-', rest)) => (true, rest),
-        Some(('+', rest)) => (false, rest),
-        _ => (false, chars),
-    };
-    match scan_number(body, 0) {
-        Some(end) if end == body.len() => to_f64(body).map(|v| if negative { -v } else { v }),
-        _ => Err(NumberError::Invalid),
-    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -238,6 +69,9 @@ pub(crate) fn parse_expression(
     cx: &ExprContext<'_>,
     diags: &mut Diags,
 ) -> Option<Expr> {
+    if let Some(v) = plain_number(chars) {
+        return Some(Expr::Num(v));
+    }
     let toks = lex(chars, col, cx, diags)?;
     let mut p = ExprParser {
         toks,
@@ -329,7 +163,7 @@ fn lex(
             {
                 i += 1;
             }
-            let name: String = chars.get(start..i).unwrap_or(&[]).iter().collect();
+            let name = super::lexer::text_of(chars.get(start..i).unwrap_or(&[]));
             toks.push((Tok::Ident(name), at));
         } else if matches!(c, '+' | '-' | '*' | '/' | '(' | ')' | ',') {
             toks.push((Tok::Op(c), at));
@@ -657,9 +491,10 @@ impl ExprParser<'_, '_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lang::symbols::Symbol;
 
     fn parse(s: &str) -> (Option<Expr>, Vec<Diagnostic>) {
-        let mut symbols = Symbols::new();
+        let mut symbols = Symbols::default();
         for n in ["a", "b", "kScale"] {
             symbols.insert(
                 n.to_string(),
@@ -711,16 +546,5 @@ mod tests {
         assert_eq!(parse(&long).1[0].code, DiagnosticCode::ExpressionTooDeep);
         let unary = "-".repeat(5000) + "a";
         assert_eq!(parse(&unary).1[0].code, DiagnosticCode::ExpressionTooDeep);
-    }
-
-    #[test]
-    fn literals() {
-        let l = |s: &str| parse_number_literal(&s.chars().collect::<Vec<_>>());
-        assert_eq!(l("-0.2"), Ok(-0.2));
-        assert_eq!(l("+3"), Ok(3.0));
-        assert_eq!(l("1e999"), Err(NumberError::NonFinite));
-        assert_eq!(l("1e"), Err(NumberError::Invalid));
-        assert_eq!(l("a"), Err(NumberError::Invalid));
-        assert_eq!(l(""), Err(NumberError::Invalid));
     }
 }

@@ -19,10 +19,10 @@
 //! once, when the script is read, and become the initial values of the generated parameters.
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
-use super::expr_parser::{
-    is_identifier, parse_expression, parse_number_literal, ExprContext, NumberError, Symbols,
-};
+use super::expr_parser::{is_identifier, parse_expression, ExprContext};
 use super::lexer::{is_blank, split_items, TokKind, Token};
+use super::numbers::{parse_number_literal, NumberError};
+use super::symbols::Symbols;
 use crate::generators::{
     generate, Fixed, Generator, GeneratorError, LatticeFixed, Topology, MAX_GENERATED_LINKS,
     MAX_GENERATED_NODES,
@@ -418,7 +418,7 @@ pub(crate) fn read(tokens: &[Token], line: u32, diags: &mut Diags, budget: &mut 
                 .filter(|g| g.kind != TokKind::Bare && g.col == end_col)
             {
                 value = Val {
-                    chars: g.text.clone(),
+                    chars: g.text.to_vec(),
                     col: g.inner_col,
                     bracket: g.kind == TokKind::Bracket,
                 };

@@ -22,18 +22,18 @@
 //! arguments, and a bare macro label without coordinates is still an error.
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
-use super::expr_parser::{SymKind, Symbols};
 use super::lexer::{is_blank, TokKind, Token};
+use super::symbols::{SymKind, Symbols};
 
 /// A bare macro label in an endpoint slot, with the coordinate tokens that go with it.
 #[derive(Debug)]
-pub(super) struct Point {
+pub(super) struct Point<'a> {
     /// The endpoint slot (0 or 1 for interactions; 0 for inputs and outputs).
     pub slot: usize,
     /// The macro's label, without `@`.
     pub target: String,
     /// One coordinate (string-like macro) or two (mesh), as tokens at their own columns.
-    pub coords: Vec<Token>,
+    pub coords: Vec<Token<'a>>,
     /// The coordinates as written (`0.3`, `u:w`, `u w`), for the note.
     written: String,
 }
@@ -41,9 +41,9 @@ pub(super) struct Point {
 /// Arguments in a legacy form, read as the modern form: the arguments without the coordinate
 /// tokens (or with the velocity added), and the connection points the coordinates make.
 #[derive(Debug)]
-pub(super) struct Read {
-    pub args: Vec<Token>,
-    pub points: Vec<Point>,
+pub(super) struct Read<'a> {
+    pub args: Vec<Token<'a>>,
+    pub points: Vec<Point<'a>>,
 }
 
 /// Which legacy form a command's keyword may take.
@@ -71,15 +71,17 @@ pub(super) struct Place<'a> {
 /// A bare macro label in an endpoint slot is an error in the modern syntax (spec §2.7), and so
 /// is a macro one argument short, so reading them as legacy forms changes the meaning of no
 /// valid script.
-pub(super) fn read(
+pub(super) fn read<'a>(
     form: Form,
     counts: (usize, usize),
-    args: &[Token],
+    args: &[Token<'a>],
     symbols: &Symbols,
     at: Place<'_>,
     diags: &mut Diags,
-) -> Option<Read> {
+) -> Option<Read<'a>> {
     match form {
+        // Without a macro there is no bare connection point to find.
+        Form::Endpoints(_) if !symbols.has_macros() => None,
         Form::Endpoints(slots) => proxy_form(slots, counts, args, symbols, at, diags),
         Form::Macro => macro_velocity(args, counts.0, at, diags),
         Form::Other => None,
@@ -87,14 +89,14 @@ pub(super) fn read(
 }
 
 /// The legacy proxy form in the arguments of a command with `slots` endpoint slots.
-fn proxy_form(
+fn proxy_form<'a>(
     slots: usize,
     (min, max): (usize, usize),
-    args: &[Token],
+    args: &[Token<'a>],
     symbols: &Symbols,
     at: Place<'_>,
     diags: &mut Diags,
-) -> Option<Read> {
+) -> Option<Read<'a>> {
     let macros: Vec<(usize, String, usize)> = (0..slots)
         .filter_map(|slot| {
             let t = args.get(slot)?;
@@ -121,7 +123,7 @@ fn proxy_form(
         let (coords, written) = match (dims, colon.as_slice()) {
             (1, []) => {
                 end -= 1;
-                (vec![last.clone()], written)
+                (vec![*last], written)
             }
             (2, [c]) => {
                 end -= 1;
@@ -136,7 +138,7 @@ fn proxy_form(
                 }
                 end -= 2;
                 let written = format!("{} {written}", before.source());
-                (vec![before.clone(), last.clone()], written)
+                (vec![*before, *last], written)
             }
             _ => return None,
         };
@@ -197,7 +199,12 @@ fn note(p: &Point, label_tok: &Token, end: usize, at: &Place<'_>) -> Diagnostic 
 /// A macro without its velocity (spec §2.7, §3.14): `min - 1` arguments, `min` being the
 /// shortest accepted count. Returns the arguments with a velocity `0` appended, and notes it at
 /// the position; `None` for any other count.
-fn macro_velocity(args: &[Token], min: usize, at: Place<'_>, diags: &mut Diags) -> Option<Read> {
+fn macro_velocity<'a>(
+    args: &[Token<'a>],
+    min: usize,
+    at: Place<'_>,
+    diags: &mut Diags,
+) -> Option<Read<'a>> {
     if args.len().checked_add(1)? != min {
         return None;
     }
@@ -220,7 +227,7 @@ fn macro_velocity(args: &[Token], min: usize, at: Place<'_>, diags: &mut Diags) 
     let mut out = args.to_vec();
     out.push(Token {
         kind: TokKind::Bare,
-        text: vec!['0'],
+        text: &['0'],
         col: pos.col,
         inner_col: pos.col,
     });
@@ -235,7 +242,7 @@ fn bare_label(t: &Token) -> Option<String> {
     if t.kind != TokKind::Bare || t.text.first() != Some(&'@') || t.text.len() < 2 {
         return None;
     }
-    Some(t.text.iter().skip(1).collect())
+    Some(t.label())
 }
 
 /// A token that can be a coordinate: a bare value (not a label) or a bracketed expression (not
@@ -269,15 +276,15 @@ fn top_level_colons(t: &Token) -> Vec<usize> {
 
 /// Splits `u:w` at the colon into two bare tokens at their own columns; `None` when a side is
 /// empty.
-fn split_at_colon(t: &Token, at: usize) -> Option<(Token, Token)> {
+fn split_at_colon<'a>(t: &Token<'a>, at: usize) -> Option<(Token<'a>, Token<'a>)> {
     let (u, w) = (t.text.get(..at)?, t.text.get(at + 1..)?);
     if u.is_empty() || w.is_empty() {
         return None;
     }
     let shift = |by: usize, col: u32| col.saturating_add(u32::try_from(by).unwrap_or(u32::MAX));
-    let part = |text: &[char], by: usize| Token {
+    let part = |text: &'a [char], by: usize| Token {
         kind: TokKind::Bare,
-        text: text.to_vec(),
+        text,
         col: shift(by, t.col),
         inner_col: shift(by, t.inner_col),
     };

@@ -52,21 +52,38 @@ pub(crate) enum TokKind {
     Quoted,
 }
 
-/// A token of a command or directive line.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Token {
+/// A token of a command or directive line. Its text borrows the script's characters, so
+/// reading a line allocates only the token list.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Token<'a> {
     pub kind: TokKind,
     /// The content (without brackets or quotes).
-    pub text: Vec<char>,
+    pub text: &'a [char],
     /// Column of the token's first character (the `[` or `'` for groups).
     pub col: u32,
     /// Column of the content's first character.
     pub inner_col: u32,
 }
 
-impl Token {
+/// The characters as a string. ASCII text, which nearly every label and number is, is copied
+/// byte for byte rather than encoded character by character.
+pub(crate) fn text_of(chars: &[char]) -> String {
+    if chars.iter().all(char::is_ascii) {
+        let bytes: Vec<u8> = chars.iter().map(|&c| c as u8).collect();
+        String::from_utf8(bytes).unwrap_or_default()
+    } else {
+        chars.iter().collect()
+    }
+}
+
+impl Token<'_> {
     pub(crate) fn string(&self) -> String {
-        self.text.iter().collect()
+        text_of(self.text)
+    }
+
+    /// The text after the first character: a label token's label, without its `@`.
+    pub(crate) fn label(&self) -> String {
+        text_of(self.text.get(1..).unwrap_or(&[]))
     }
 
     /// The token as written in the script, for messages.
@@ -117,8 +134,13 @@ fn ends_with_exponent_marker(tok: &[char]) -> bool {
 /// Tokenises one command or directive line (spec §3.3). A `#` outside a quoted group starts a
 /// comment (spec §3.2). Reports the first lexical error of the line and returns `None` then;
 /// warns about `+` separators between two non-blank characters.
-pub(crate) fn tokenize(chars: &[char], line: u32, diags: &mut Diags) -> Option<Vec<Token>> {
-    let mut tokens = Vec::new();
+pub(crate) fn tokenize<'a>(
+    chars: &'a [char],
+    line: u32,
+    diags: &mut Diags,
+) -> Option<Vec<Token<'a>>> {
+    // A command has a label, a keyword and up to seven arguments: one allocation for most lines.
+    let mut tokens = Vec::with_capacity(8);
     let mut i = 0;
     while let Some(&c) = chars.get(i) {
         if is_blank(c) {
@@ -175,7 +197,7 @@ pub(crate) fn tokenize(chars: &[char], line: u32, diags: &mut Diags) -> Option<V
                 }
                 tokens.push(Token {
                     kind: TokKind::Bracket,
-                    text: chars.get(i + 1..j).unwrap_or(&[]).to_vec(),
+                    text: chars.get(i + 1..j).unwrap_or(&[]),
                     col: col_of(i),
                     inner_col: col_of(i + 1),
                 });
@@ -206,7 +228,7 @@ pub(crate) fn tokenize(chars: &[char], line: u32, diags: &mut Diags) -> Option<V
                 let j = i + 1 + len;
                 tokens.push(Token {
                     kind: TokKind::Quoted,
-                    text: chars.get(i + 1..j).unwrap_or(&[]).to_vec(),
+                    text: chars.get(i + 1..j).unwrap_or(&[]),
                     col: col_of(i),
                     inner_col: col_of(i + 1),
                 });
@@ -214,17 +236,13 @@ pub(crate) fn tokenize(chars: &[char], line: u32, diags: &mut Diags) -> Option<V
             }
             _ => {
                 let start = i;
-                let mut text = Vec::new();
                 while let Some(&c) = chars.get(i) {
-                    if is_bare_char(c) {
-                        text.push(c);
-                        i += 1;
-                    } else if c == '+'
-                        && chars.get(i + 1).is_some_and(char::is_ascii_digit)
-                        && ends_with_exponent_marker(&text)
+                    if is_bare_char(c)
+                        || (c == '+'
+                            && chars.get(i + 1).is_some_and(char::is_ascii_digit)
+                            && ends_with_exponent_marker(chars.get(start..i).unwrap_or(&[])))
                     {
                         // `2.5e+3`: the `+` belongs to the number (spec §3.3).
-                        text.push(c);
                         i += 1;
                     } else {
                         break;
@@ -232,7 +250,7 @@ pub(crate) fn tokenize(chars: &[char], line: u32, diags: &mut Diags) -> Option<V
                 }
                 tokens.push(Token {
                     kind: TokKind::Bare,
-                    text,
+                    text: chars.get(start..i).unwrap_or(&[]),
                     col: col_of(start),
                     inner_col: col_of(start),
                 });

@@ -38,8 +38,10 @@ mod expr_parser;
 mod generate;
 mod legacy;
 mod lexer;
+mod numbers;
 mod parser;
 mod printer;
+mod symbols;
 
 pub use diagnostics::{Diagnostic, DiagnosticCode, Severity, MAX_DIAGNOSTICS};
 pub use expr_parser::MAX_NESTING;

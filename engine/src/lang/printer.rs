@@ -379,7 +379,10 @@ pub fn print(spec: &ModelSpec) -> String {
                 let _ = writeln!(out, "@{} param {}", p.name, format_number(value));
             }
             // A zero default is left out: the MIMS4Max form, which means the same.
-            ParamKind::Audio { input, default } if default == 0.0 => {
+            ParamKind::Audio {
+                input,
+                default: 0.0,
+            } => {
                 let _ = writeln!(out, "@{} audioParam @in{input}", p.name);
             }
             ParamKind::Audio { input, default } => {

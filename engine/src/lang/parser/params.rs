@@ -1,13 +1,13 @@
 //! `param` and `audioParam` commands (spec §3.8): the parameter name, a control parameter's
 //! value, and an audio-rate parameter's input and optional default.
 
-use super::{At, Builder, Shape};
+use super::keywords::Shape;
+use super::{At, Builder};
 use crate::expr::Func;
 use crate::lang::diagnostics::DiagnosticCode;
-use crate::lang::expr_parser::{
-    is_identifier, parse_number_literal, token_number_literal, NumberError,
-};
+use crate::lang::expr_parser::is_identifier;
 use crate::lang::lexer::{TokKind, Token};
+use crate::lang::numbers::{parse_number_literal, token_number_literal, NumberError};
 use crate::spec::{ParamDecl, ParamKind, Span};
 
 impl Builder<'_> {
@@ -59,7 +59,7 @@ impl Builder<'_> {
             let swapped = args.len() == 2
                 && args[1].kind == TokKind::Bare
                 && args[1].text.first() == Some(&'@')
-                && parse_number_literal(&v.text).is_ok();
+                && parse_number_literal(v.text).is_ok();
             let message = if swapped {
                 format!(
                     "`audioParam` takes its input first and its default after it: write `{} {}`",

@@ -1,0 +1,89 @@
+//! Maps keyed by script labels, for the parser's and the compiler's symbol tables.
+//!
+//! A script written element by element has a label on every line and names two or three more
+//! in its arguments, so loading a 1000-mass string hashes some ten thousand short strings.
+//! std's default SipHash costs about as much as the rest of reading a line; labels come from a
+//! script the user loads, not from an adversary, so a multiplicative hash (the one rustc uses
+//! for its own symbol tables) serves: a few cycles per eight bytes.
+
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A `HashMap` with [`LabelHasher`]. Iteration order is unspecified, as with std's.
+pub(crate) type LabelMap<K, V> = HashMap<K, V, BuildHasherDefault<LabelHasher>>;
+
+/// A multiplicative word-at-a-time hash for short keys (not collision-resistant).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct LabelHasher(u64);
+
+const SEED: u64 = 0x51_7c_c1_b7_27_22_0a_95;
+
+impl LabelHasher {
+    #[inline]
+    fn add(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(SEED);
+    }
+}
+
+impl Hasher for LabelHasher {
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        let mut words = bytes.chunks_exact(8);
+        for w in &mut words {
+            let mut b = [0u8; 8];
+            b.copy_from_slice(w);
+            self.add(u64::from_le_bytes(b));
+        }
+        let rest = words.remainder();
+        if !rest.is_empty() {
+            let mut b = [0u8; 8];
+            b[..rest.len()].copy_from_slice(rest);
+            self.add(u64::from_le_bytes(b));
+        }
+    }
+
+    #[inline]
+    fn write_u8(&mut self, i: u8) {
+        self.add(u64::from(i));
+    }
+
+    #[inline]
+    fn write_u32(&mut self, i: u32) {
+        self.add(u64::from(i));
+    }
+
+    #[inline]
+    fn write_u64(&mut self, i: u64) {
+        self.add(i);
+    }
+
+    #[inline]
+    fn write_usize(&mut self, i: usize) {
+        self.add(i as u64);
+    }
+
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_that_differ_hash_apart() {
+        let mut m: LabelMap<String, usize> = LabelMap::default();
+        for k in 0..10_000 {
+            m.insert(format!("n{k}"), k);
+        }
+        assert_eq!(m.len(), 10_000);
+        assert!((0..10_000).all(|k| m.get(format!("n{k}").as_str()) == Some(&k)));
+        // A prefix and a string padded with NUL bytes stay distinct keys.
+        let mut m: LabelMap<&str, u8> = LabelMap::default();
+        m.insert("a", 1);
+        m.insert("a\0", 2);
+        assert_eq!((m.get("a"), m.get("a\0")), (Some(&1), Some(&2)));
+    }
+}

@@ -1,0 +1,156 @@
+//! The lines of a script (spec §3.2): command and directive lines become tokenised items.
+
+use super::keywords::shape_of;
+use crate::lang::diagnostics::{Diagnostic, DiagnosticCode, Diags};
+use crate::lang::generate::{self, GenRequest};
+use crate::lang::lexer::{is_blank, tokenize, TokKind, Token};
+
+/// Reads the script's lines (`(line number, range in buffer)`) into items: command and
+/// directive lines tokenised, comments and blank lines skipped, other lines ignored with a
+/// warning when they look like a command.
+pub(super) fn read_items<'a>(
+    buffer: &'a [char],
+    lines: Vec<(u32, std::ops::Range<usize>)>,
+    diags: &mut Diags,
+) -> Vec<Item<'a>> {
+    let mut items = Vec::with_capacity(lines.len());
+    for (line, range) in lines {
+        let chars = buffer.get(range).unwrap_or(&[]);
+        let Some(first) = chars.iter().position(|c| !is_blank(*c)) else {
+            continue;
+        };
+        match chars.get(first) {
+            Some('@') | Some('~') => {
+                let directive = chars.get(first) == Some(&'~');
+                match tokenize(chars, line, diags) {
+                    Some(tokens) => items.push(Item {
+                        line,
+                        directive,
+                        broken: false,
+                        tokens,
+                        generator: None,
+                        broken_generator: None,
+                    }),
+                    None if !directive => {
+                        // Keep the label known so references to it do not cascade: the line
+                        // takes part in pass 1 with its label only (kind unknown).
+                        let rest = chars.get(first..).unwrap_or(&[]);
+                        let len = rest
+                            .iter()
+                            .take_while(|c| {
+                                !is_blank(**c) && !matches!(c, '+' | '[' | ']' | '\'' | '#')
+                            })
+                            .count();
+                        let label = rest.get(..len).unwrap_or(&[]);
+                        items.push(Item {
+                            line,
+                            directive: false,
+                            broken: true,
+                            tokens: vec![Token {
+                                kind: TokKind::Bare,
+                                text: label,
+                                col: col_of(first),
+                                inner_col: col_of(first),
+                            }],
+                            generator: None,
+                            broken_generator: None,
+                        });
+                    }
+                    None => {
+                        // A `~generate` line with a lexical error: its labels are unknown, so
+                        // references to them must not cascade.
+                        let text: String = chars.iter().skip(first).collect();
+                        let words: Vec<&str> = text
+                            .split(is_blank)
+                            .filter(|w| !w.is_empty())
+                            .take(3)
+                            .collect();
+                        if let Some(name) = generate::broken_name(&words) {
+                            items.push(Item {
+                                line,
+                                directive: true,
+                                broken: true,
+                                tokens: Vec::new(),
+                                generator: None,
+                                broken_generator: Some(name),
+                            });
+                        }
+                    }
+                }
+            }
+            Some('#') => {}
+            _ => check_ignored_line(chars, line, diags),
+        }
+    }
+    items
+}
+
+fn col_of(i: usize) -> u32 {
+    u32::try_from(i.saturating_add(1)).unwrap_or(u32::MAX)
+}
+
+/// Warns when an ignored line looks like a command with a forgotten `@` (spec §3.2): its first
+/// word is a type keyword (`mass 1 0 0`), or its second word is one after a label-like first
+/// word (`m mass 1 0 0`).
+fn check_ignored_line(chars: &[char], line: u32, diags: &mut Diags) {
+    let mut words: Vec<(usize, String)> = Vec::new();
+    let mut i = 0;
+    while words.len() < 2 {
+        while chars.get(i).is_some_and(|c| is_blank(*c)) {
+            i += 1;
+        }
+        let start = i;
+        while chars.get(i).is_some_and(|c| !is_blank(*c) && *c != '#') {
+            i += 1;
+        }
+        if i == start {
+            break;
+        }
+        words.push((start, chars.get(start..i).unwrap_or(&[]).iter().collect()));
+        if chars.get(i) == Some(&'#') {
+            break;
+        }
+    }
+    let hit = match words.as_slice() {
+        [(c, w), ..] if shape_of(w).is_some() => Some((*c, w.clone(), false)),
+        [(c, l), (_, w)]
+            if shape_of(w).is_some() && l.chars().all(|c| c.is_alphanumeric() || c == '_') =>
+        {
+            Some((*c, w.clone(), true))
+        }
+        _ => None,
+    };
+    if let Some((c, keyword, has_label)) = hit {
+        let message = if has_label {
+            format!("line ignored: it looks like a `{keyword}` command whose label lacks `@`")
+        } else {
+            format!(
+                "line ignored: it starts with the type keyword `{keyword}`; commands start \
+                 with `@label`"
+            )
+        };
+        diags.push(
+            Diagnostic::new(DiagnosticCode::IgnoredCommandLike, line, col_of(c), message)
+                .with_expected("@label keyword arguments…"),
+        );
+    }
+}
+
+/// A command or directive line, tokenised.
+pub(super) struct Item<'a> {
+    pub(super) line: u32,
+    pub(super) directive: bool,
+    /// A command line with a lexical error: only its label token is kept, for pass 1.
+    pub(super) broken: bool,
+    pub(super) tokens: Vec<Token<'a>>,
+    /// A `~generate` directive read in pass 1 and expanded in pass 2.
+    pub(super) generator: Option<Box<GenRequest>>,
+    /// The name of a `~generate` line with a lexical error: its labels are unknown.
+    pub(super) broken_generator: Option<String>,
+}
+
+pub(super) fn is_generate(item: &Item) -> bool {
+    item.directive && item.tokens.first().is_some_and(|t| *t.text == GENERATE)
+}
+
+pub(super) const GENERATE: [char; 9] = ['~', 'g', 'e', 'n', 'e', 'r', 'a', 't', 'e'];
