@@ -235,7 +235,8 @@ pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
             return Err(Failure::Model);
         }
     };
-    if let Some(v) = a.voices {
+    // --voices, else the script's `~voices`, as the plugin's Voices does by default.
+    if let Some(v) = a.voices.or(model.settings.voices.map(|v| v as usize)) {
         if !(1..=MAX_VOICES).contains(&v) {
             return Err(usage(format!(
                 "--voices {v}: the plugin plays 1 to {MAX_VOICES} voices"

@@ -536,6 +536,8 @@ pub struct HostSpec {
     pub routes: Vec<Route>,
     /// `~macro` lines, in script order.
     pub macro_ranges: Vec<MacroRange>,
+    /// `~voices N`: how many notes the model plays at once by default (1 … 1024).
+    pub voices: Option<u32>,
 }
 
 impl ModelSpec {

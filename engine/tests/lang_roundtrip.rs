@@ -519,8 +519,9 @@ fn script_generator_reaches_valid_scripts() {
 fn host_directives_round_trip() {
     let text = "@K param 0.1\n@m osc 1 K 0.001 0 0\n@in1 frcInput @m\n@in2 frcInput @m\n\
                 @out1 posOutput @m\n~pitch 261.625\n~key 60.5\n~note in2 -0.05\n\
-                ~route in1 sidechain_right\n~route in2 none\n~macro K 0.05 2e-1\n";
+                ~route in1 sidechain_right\n~route in2 none\n~macro K 0.05 2e-1\n~voices 8\n";
     let first = ressort_engine::parse(text).spec.expect("parses");
+    assert_eq!(first.host.voices, Some(8));
     assert_eq!(first.host.pitch_hz, Some(261.625));
     assert_eq!(first.host.note_input, Some(2));
     assert_eq!(first.host.routes.len(), 2);
@@ -610,4 +611,23 @@ fn audio_param_defaults_round_trip() {
          @cY audioParam @in6\n"
     );
     assert_eq!(ressort_engine::parse(&printed).spec, Some(first));
+}
+
+/// `~voices` takes a whole number from 1 to 1024, once.
+#[test]
+fn voice_counts_are_checked() {
+    for bad in ["0", "1025", "2.5", "many"] {
+        let p = ressort_engine::parse(&format!("@o osc 1 0.1 0.001 0 0\n~voices {bad}\n"));
+        let errors: Vec<String> = p.errors().map(|d| d.to_string()).collect();
+        assert!(
+            errors
+                .iter()
+                .any(|e| e.contains("2:9") && e.contains("voice count")),
+            "~voices {bad}: {errors:?}"
+        );
+    }
+    let twice = ressort_engine::parse("@o osc 1 0.1 0.001 0 0\n~voices 4\n~voices 8\n");
+    assert!(twice
+        .errors()
+        .any(|d| d.to_string().contains("a second `~voices`")));
 }

@@ -357,7 +357,9 @@ fn gallery_scripts_equal_the_builder_reference_models() {
         ("fretted-string.mdl", reference::fretted_string()),
         ("chladni-150x150.mdl", reference::chladni_150()),
     ] {
-        let parsed = preset(file);
+        let mut parsed = preset(file);
+        // The host directives (`~voices`, …) are the plugin's; the physics is the builder's.
+        parsed.host = Default::default();
         // Element by element first, for a readable failure on a 200-line model.
         for (i, (a, b)) in parsed.elements.iter().zip(&spec.elements).enumerate() {
             assert_eq!(a, b, "{file}: element {i} differs from the builder model");

@@ -37,6 +37,19 @@ fn render(
     events: &[(u32, Event)],
     frames: usize,
 ) -> Render {
+    render_with(script, voices, controls, events, frames, None)
+}
+
+/// With `sidechain`, a signal on the sidechain's first channel (`@in1` in the instrument
+/// layout).
+fn render_with(
+    script: &str,
+    voices: usize,
+    controls: Controls,
+    events: &[(u32, Event)],
+    frames: usize,
+    sidechain: Option<&[f32]>,
+) -> Render {
     let mut model = instrument::prepare("test", script, SR).unwrap();
     model.set_voices(voices);
     let mut inst = Instrument::new(SR, controls);
@@ -53,7 +66,8 @@ fn render(
             .iter()
             .filter(|(t, _)| (*t as usize) >= start && (*t as usize) < start + n)
             .map(|&(t, e)| Timed::new(t - start as u32, e));
-        let host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+        let mut host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+        host[2] = sidechain.map(|s| &s[start..start + n]);
         let mut out: [&mut [f32]; 2] = [&mut left[start..start + n], &mut right[start..start + n]];
         inst.process(n, &host, false, &mut ev, &controls, &mut out);
         inst.drain_ended(|e| ended.push(e.note));
@@ -236,4 +250,24 @@ fn release_damps_only_released_voices_and_the_pedal_holds_them() {
         held, pedalled,
         "the pedal holds the note: nothing is released"
     );
+}
+
+#[test]
+fn host_audio_still_strikes_the_model_without_notes() {
+    // With voices, the model itself keeps playing what the sidechain feeds it, exactly as the
+    // monophonic instrument does; notes add voices of their own.
+    let mut side = vec![0.0f32; 24_000];
+    side[10] = -0.05;
+    // The knobs act on it too.
+    let controls = Controls {
+        stiffness_octaves: 1.0,
+        damping_octaves: -1.0,
+        ..quiet()
+    };
+    let poly = render_with(DAMPED, 8, controls, &[], 24_000, Some(&side)).left;
+    let mono = render_with(DAMPED, 1, controls, &[], 24_000, Some(&side)).left;
+    let plain = render_with(DAMPED, 1, quiet(), &[], 24_000, Some(&side)).left;
+    assert_ne!(mono, plain, "Stiffness and Damping must change the sound");
+    assert!(peak(&mono) > 1e-3, "the sidechain strikes");
+    assert_eq!(poly, mono);
 }

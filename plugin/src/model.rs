@@ -21,8 +21,8 @@ pub use ressort_engine::instrument::{
 use ressort_engine::InputUse;
 use serde::{Deserialize, Serialize};
 
-/// The largest Voices setting.
-pub const MAX_VOICES: usize = 64;
+/// The largest Voices setting (0 means the script's `~voices`).
+pub const MAX_VOICES: usize = 128;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -37,7 +37,8 @@ pub struct ModelState {
 
 /// Prepares a script for the instrument ([`instrument::prepare`]) with a motion channel for
 /// the editor: the model publishes its positions, the reader goes to the editor.
-/// `voices` is the Voices setting (1 plays monophonically).
+/// `voices` is the Voices setting: 0 takes the script's `~voices` (1 without one), 1 plays
+/// monophonically.
 pub fn prepare(
     name: &str,
     text: &str,
@@ -45,7 +46,8 @@ pub fn prepare(
     voices: usize,
 ) -> Result<(Prepared, MotionReader), Rejected> {
     let mut prepared = instrument::prepare(name, text, sample_rate)?;
-    prepared.set_voices(voices);
+    let declared = prepared.settings.voices.unwrap_or(1) as usize;
+    prepared.set_voices(if voices == 0 { declared } else { voices });
     let (writer, reader) = motion_channel(&prepared.engine, sample_rate);
     prepared.watcher = Some(Box::new(writer));
     Ok((prepared, reader))
@@ -65,6 +67,10 @@ pub struct ModelSummary {
     pub stability: Vec<String>,
     pub reference_pitch_hz: Option<f64>,
     pub reference_key: f64,
+    /// The script's `~voices`.
+    pub declared_voices: Option<u32>,
+    /// The voices the model was prepared with.
+    pub voices: usize,
 }
 
 /// The result of a script submission.
@@ -132,6 +138,8 @@ pub fn summary(prepared: &mut Prepared) -> ModelSummary {
         stability,
         reference_pitch_hz: prepared.settings.reference_pitch_hz,
         reference_key: prepared.settings.reference_key,
+        declared_voices: prepared.settings.voices,
+        voices: prepared.voices(),
     }
 }
 
@@ -199,7 +207,7 @@ impl Default for ModelStore {
             garbage: crossbeam_channel::bounded(64),
             motion: Mutex::new(None),
             compare: Mutex::new(Compare::default()),
-            voices: AtomicU64::new(1),
+            voices: AtomicU64::new(0),
             voices_stale: AtomicBool::new(false),
             runtime: RuntimeStatus::default(),
         }
@@ -301,9 +309,18 @@ impl ModelStore {
 
     /// The Voices setting new models are prepared with.
     pub fn voices(&self) -> usize {
-        self.voices
-            .load(Ordering::Acquire)
-            .clamp(1, MAX_VOICES as u64) as usize
+        self.voices.load(Ordering::Acquire).min(MAX_VOICES as u64) as usize
+    }
+
+    /// The Voices parameter's text: `script (N)` for 0, where N is the running script's
+    /// `~voices` (1 without one), else the count.
+    pub fn voices_text(&self, setting: i32) -> String {
+        if setting <= 0 {
+            let declared = lock(&self.status).summary.declared_voices.unwrap_or(1);
+            format!("script ({declared})")
+        } else {
+            setting.to_string()
+        }
     }
 
     /// The Voices parameter moved (on any thread, the audio thread included: this only

@@ -64,9 +64,9 @@ pub struct RessortParams {
     #[id = "model_edits"]
     pub model_edits: IntParam,
 
-    /// How many notes sound at once: 1 plays monophonically (a note retunes the one model);
-    /// more give every note its own copy of the model. Not automatable: a change re-prepares
-    /// the model.
+    /// How many notes sound at once: 0 takes the script's `~voices` (1 without one), 1 plays
+    /// monophonically (a note retunes the one model), more give every note its own copy of
+    /// the model. Not automatable: a change re-prepares the model.
     #[id = "voices"]
     pub voices: IntParam,
 
@@ -183,17 +183,29 @@ impl RessortParams {
                 .hide()
                 .non_automatable(),
             voices: {
-                let store = voices_store;
+                let store = voices_store.clone();
+                let text_store = voices_store;
                 IntParam::new(
                     "Voices",
-                    1,
+                    0,
                     IntRange::Linear {
-                        min: 1,
+                        min: 0,
                         max: MAX_VOICES as i32,
                     },
                 )
                 .non_automatable()
-                .with_callback(Arc::new(move |v| store.set_voices(v.max(1) as usize)))
+                .with_callback(Arc::new(move |v| store.set_voices(v.max(0) as usize)))
+                .with_value_to_string(Arc::new(move |v| text_store.voices_text(v)))
+                .with_string_to_value(Arc::new(|t| {
+                    let t = t.trim().to_ascii_lowercase();
+                    if t.starts_with("script") || t == "auto" {
+                        Some(0)
+                    } else {
+                        t.parse::<i32>()
+                            .ok()
+                            .filter(|v| (0..=MAX_VOICES as i32).contains(v))
+                    }
+                }))
             },
             release: FloatParam::new(
                 "Release",

@@ -151,7 +151,8 @@ fn the_voices_setting_survives_the_state_and_follows_the_host() {
     // the chord becomes monophonic.
     let voices = second.param("Voices").id;
     second.activate(SR, 1, 512);
-    // A stepped parameter's CLAP value counts steps from its minimum: 0 is 1 voice.
+    // A stepped parameter's CLAP value counts steps from its minimum: 0 is the script's
+    // count, 1 here (no `~voices`).
     second.render_frames(512, 512, &Score::new().param(0, voices, 0.0));
     second.idle();
     second.render_frames(4_800, 512, &Score::new());

@@ -52,6 +52,8 @@ pub struct HostSettings {
     /// The MIDI key at which the model sounds as written.
     pub reference_key: f64,
     pub macro_ranges: Vec<MacroRange>,
+    /// `~voices N`: the notes the model plays at once unless the host says otherwise.
+    pub voices: Option<u32>,
 }
 
 impl Default for HostSettings {
@@ -63,13 +65,14 @@ impl Default for HostSettings {
             reference_pitch_hz: None,
             reference_key: 60.0,
             macro_ranges: Vec::new(),
+            voices: None,
         }
     }
 }
 
 impl HostSettings {
     /// Reads the host directives of a parsed model (`~pitch`, `~key`, `~note`, `~route`,
-    /// `~macro`; see docs/LANGUAGE.md §12.3).
+    /// `~macro`, `~voices`; see docs/LANGUAGE.md §12.3).
     pub fn from_spec(spec: &ModelSpec) -> Result<HostSettings, Vec<String>> {
         let h = &spec.host;
         let defaults = HostSettings::default();
@@ -88,6 +91,7 @@ impl HostSettings {
             reference_pitch_hz: h.pitch_hz,
             reference_key: h.key.unwrap_or(defaults.reference_key),
             macro_ranges: h.macro_ranges.clone(),
+            voices: h.voices,
         })
     }
 }

@@ -274,7 +274,9 @@ impl Instrument {
             macro_envelopes: &m.macro_envelopes,
         };
         let release = 16f64.powf(self.controls.release);
+        // The model itself, which the host's audio plays, at the reference key.
         let mut shown = self.smoothed.gains(&view, 0.0, 1.0);
+        self.smoothed.set(&mut m.engine, view.macros, &shown);
         let mut newest = 0;
         for v in bank.voices.iter_mut() {
             if v.state == VoiceState::Free {
@@ -531,7 +533,13 @@ impl Instrument {
             let n_in = m.roles.len();
             let n_out = m.outputs.len() / CHUNK;
             if let Some(bank) = m.bank.as_mut() {
-                // The voices, each with the host's inputs and its own strike.
+                // The model itself keeps playing what the host feeds it (a sidechain strikes
+                // it as without voices); notes play on voices of their own, which hear the
+                // host's inputs too and their own strike.
+                let r =
+                    m.engine
+                        .process(len, &m.inputs[..n_in * len], &mut m.outputs[..n_out * len]);
+                tripped |= r.tripped;
                 let strike_force = m.settings.note_force * m.strike_scale * force;
                 tripped |= bank.process(
                     len,
@@ -570,6 +578,15 @@ impl Instrument {
                 &old.inputs[..n_in * len],
                 &mut old.outputs[..n_out * len],
             );
+            if let Some(bank) = old.bank.as_mut() {
+                bank.process(
+                    len,
+                    &old.inputs[..n_in * len],
+                    &mut old.outputs[..n_out * len],
+                    None,
+                    0.0,
+                );
+            }
         }
         // Output stage.
         let span = Span {

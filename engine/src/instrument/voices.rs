@@ -290,8 +290,8 @@ impl VoiceBank {
     }
 
     /// Runs one span of `len` samples: every voice that is not free hears `inputs` (the
-    /// model's planar input scratch) plus its own strike, and the voices' outputs are summed
-    /// into `outputs` (planar, `n_out` channels). A strike enters the note input × `strike_force`.
+    /// model's planar input scratch) plus its own strike, and the voices' outputs are added
+    /// to `outputs` (planar, `n_out` channels). A strike enters the note input × `strike_force`.
     /// Returns whether a voice's guard tripped (that voice is freed).
     pub fn process(
         &mut self,
@@ -301,7 +301,6 @@ impl VoiceBank {
         note_input: Option<usize>,
         strike_force: f64,
     ) -> bool {
-        outputs.fill(0.0);
         let mut tripped = false;
         for i in 0..self.voices.len() {
             if self.voices[i].state == VoiceState::Free {

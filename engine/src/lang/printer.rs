@@ -399,6 +399,9 @@ pub fn print(spec: &ModelSpec) -> String {
     if let Some(v) = h.pitch_hz {
         let _ = writeln!(out, "~pitch {}", format_number(v));
     }
+    if let Some(v) = h.voices {
+        let _ = writeln!(out, "~voices {v}");
+    }
     if let Some(v) = h.key {
         let _ = writeln!(out, "~key {}", format_number(v));
     }

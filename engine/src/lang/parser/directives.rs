@@ -33,7 +33,10 @@ impl Builder<'_> {
             line: item.line,
             label: None,
         };
-        if matches!(name.as_str(), "pitch" | "key" | "note" | "route" | "macro") {
+        if matches!(
+            name.as_str(),
+            "pitch" | "key" | "note" | "route" | "macro" | "voices"
+        ) {
             self.host_directive(item, &name, first.col, args);
             return;
         }
@@ -48,7 +51,8 @@ impl Builder<'_> {
                         format!("unknown directive `~{name}` ignored"),
                     )
                     .with_expected(
-                        "~begin, ~end, ~samplerate, ~generate, ~pitch, ~key, ~note, ~route or ~macro",
+                        "~begin, ~end, ~samplerate, ~generate, ~pitch, ~key, ~note, ~route, \
+                         ~macro or ~voices",
                     )
                     .with_found(format!("~{name}")),
                 );
@@ -181,7 +185,11 @@ impl Builder<'_> {
         let (expected, count): (&str, &[usize]) = match name {
             "pitch" => ("a frequency in Hz (a positive number)", &[1]),
             "key" => ("a MIDI key number, 0 to 127", &[1]),
-            "note" => ("an input (`in1`…) and optionally the force of a full-velocity note", &[1, 2]),
+            "voices" => ("a number of voices, 1 to 1024", &[1]),
+            "note" => (
+                "an input (`in1`…) and optionally the force of a full-velocity note",
+                &[1, 2],
+            ),
             "route" => (
                 "an input (`in1`…) and main_left, main_right, sidechain_left, sidechain_right, \
                  sidechain_3 … sidechain_8 or none",
@@ -267,6 +275,18 @@ impl Builder<'_> {
                     &mut self.diags,
                     args[0].col,
                     "the key must be a MIDI key number from 0 to 127".into(),
+                    Some(args[0].source()),
+                ),
+            },
+            "voices" => match number(&args[0])
+                .filter(|v| v.fract() == 0.0 && (1.0..=MAX_VOICES as f64).contains(v))
+            {
+                Some(v) if host.voices.is_none() => host.voices = Some(v as u32),
+                Some(_) => conflict(&mut self.diags, "the model"),
+                None => bad(
+                    &mut self.diags,
+                    args[0].col,
+                    format!("the voice count must be a whole number from 1 to {MAX_VOICES}"),
                     Some(args[0].source()),
                 ),
             },
@@ -363,3 +383,6 @@ impl Builder<'_> {
         }
     }
 }
+
+/// The most voices `~voices` declares.
+pub const MAX_VOICES: u32 = 1024;
