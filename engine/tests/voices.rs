@@ -271,3 +271,36 @@ fn host_audio_still_strikes_the_model_without_notes() {
     assert!(peak(&mono) > 1e-3, "the sidechain strikes");
     assert_eq!(poly, mono);
 }
+
+#[test]
+fn drunk_triangles_play_100_overlapping_notes_and_free_their_voices() {
+    // The paper's instrument: every note drops a mass on its own triangle, tuned to the note;
+    // a voice frees itself once its mass rests on the triangle (away from where it started).
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../models/drunk-triangles.mdl"
+    ))
+    .unwrap();
+    let declared = instrument::prepare("dt", &text, SR)
+        .unwrap()
+        .settings
+        .voices;
+    assert_eq!(declared, Some(100));
+    let events: Vec<(u32, Event)> = (0..100u32)
+        .map(|i| (i * 960, Event::note_on(40 + (i % 40) as u8, 0.8)))
+        .collect();
+    let r = render(&text, 100, Controls::DEFAULT, &events, 12 * 48_000);
+    let most = r.sounding.iter().copied().max().unwrap();
+    let last = *r.sounding.last().unwrap();
+    println!(
+        "100 notes over 2 s: {most} voices at most, {last} still sounding at 12 s, {} ended",
+        r.ended.len()
+    );
+    assert!(r.left.iter().all(|x| x.is_finite() && x.abs() <= 1.0));
+    assert_eq!(most, 100, "every note gets a voice");
+    assert_eq!(r.ended.len() + last, 100, "a voice ends at most once");
+    assert!(
+        r.ended.len() >= 50,
+        "the voices whose masses rest must free themselves"
+    );
+}

@@ -7,9 +7,11 @@
 //! the note by the exact law and strikes it. When `limit` voices sound, the quietest one is
 //! stolen: it fades out over [`STEAL_FADE_MS`] in a spare slot while the new note starts at
 //! once. A voice frees itself when its motion has stayed below [`FREE_LEVEL`] for
-//! [`FREE_AFTER_MS`]: the largest distance of any point from its rest position or from its
-//! previous position — a state check, as mi-gen~'s Drunk Triangles does with the gap between
-//! its falling mass and the triangle, not an output level.
+//! [`FREE_AFTER_MS`]: the largest distance any point moved in the last sample or since the last
+//! check (a control chunk earlier) — a state check, as mi-gen~'s Drunk Triangles does with the
+//! gap between its falling mass and the triangle, not an output level. Where a point comes to
+//! rest does not matter: gravity and contacts leave static offsets (a dropped mass lies on its
+//! triangle, away from where it started).
 
 use super::CHUNK;
 use crate::Engine;
@@ -53,6 +55,8 @@ pub struct Voice {
     /// Samples spent below [`FREE_LEVEL`], and the last motion measured.
     quiet: u64,
     pub level: f64,
+    /// Every point's position at the last check.
+    last: Vec<f64>,
     /// Output gain (1 but while fading) and its step per sample.
     gain: f64,
     fade_step: f64,
@@ -75,8 +79,6 @@ pub struct VoiceBank {
     /// How many voices may sound at once (the Voices setting); the rest of the capacity
     /// holds stolen voices while they fade.
     pub limit: usize,
-    /// Every point's position at rest.
-    rest: Vec<f64>,
     clock: u64,
     pub sustain: bool,
     free_after: u64,
@@ -100,7 +102,7 @@ impl VoiceBank {
         let capacity = limit + (limit / 4).max(1);
         let mut engine = template.clone();
         engine.reset();
-        let rest = engine.positions().to_vec();
+        let last = engine.positions().to_vec();
         let voice = Voice {
             engine,
             inputs: vec![0.0; n_in * CHUNK],
@@ -114,6 +116,7 @@ impl VoiceBank {
             started: 0,
             quiet: 0,
             level: 0.0,
+            last,
             gain: 1.0,
             fade_step: 0.0,
             strike: 0.0,
@@ -121,7 +124,6 @@ impl VoiceBank {
         VoiceBank {
             voices: vec![voice; capacity],
             limit,
-            rest,
             clock: 0,
             sustain: false,
             free_after: (FREE_AFTER_MS * 1e-3 * sample_rate) as u64,
@@ -191,6 +193,7 @@ impl VoiceBank {
         v.started = self.clock;
         v.quiet = 0;
         v.level = f64::INFINITY;
+        v.last.copy_from_slice(v.engine.positions());
         v.gain = 1.0;
         v.fade_step = 0.0;
         v.strike = strike;
@@ -356,8 +359,9 @@ impl VoiceBank {
             let x = v.engine.positions();
             let xp = v.engine.delayed_positions();
             let mut level: f64 = 0.0;
-            for ((x, xp), r) in x.iter().zip(xp).zip(&self.rest) {
-                level = level.max((x - r).abs()).max((x - xp).abs());
+            for ((x, xp), last) in x.iter().zip(xp).zip(v.last.iter_mut()) {
+                level = level.max((x - xp).abs()).max((x - *last).abs());
+                *last = *x;
             }
             v.level = level;
             if level < FREE_LEVEL {
