@@ -43,23 +43,37 @@ pub fn read_events(bytes: &[u8], sample_rate: f64) -> Result<Vec<(u64, Event)>, 
             TrackEventKind::Meta(MetaMessage::Tempo(t)) => {
                 micros_per_beat = f64::from(t.as_int()).max(1.0);
             }
-            TrackEventKind::Midi { message, .. } => {
+            TrackEventKind::Midi { message, channel } => {
+                let channel = channel.as_int();
                 let event = match message {
                     MidiMessage::NoteOn { key, vel } if vel.as_int() > 0 => Event::NoteOn {
-                        channel: 0,
+                        channel,
                         voice_id: None,
                         note: key.as_int(),
                         velocity: vel.as_int() as f32 / 127.0,
                     },
                     MidiMessage::NoteOn { key, .. } | MidiMessage::NoteOff { key, .. } => {
                         Event::NoteOff {
-                            channel: 0,
+                            channel,
                             voice_id: None,
                             note: key.as_int(),
                         }
                     }
                     MidiMessage::PitchBend { bend } => Event::PitchBend {
                         value: (bend.as_int() as f32 + 8192.0) / 16383.0,
+                        channel,
+                    },
+                    MidiMessage::ChannelAftertouch { vel } => Event::Pressure {
+                        value: vel.as_int() as f32 / 127.0,
+                        channel,
+                        note: None,
+                        voice_id: None,
+                    },
+                    MidiMessage::Aftertouch { key, vel } => Event::Pressure {
+                        value: vel.as_int() as f32 / 127.0,
+                        channel,
+                        note: Some(key.as_int()),
+                        voice_id: None,
                     },
                     MidiMessage::Controller { controller, value } => Event::Controller {
                         cc: controller.as_int(),

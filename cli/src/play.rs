@@ -67,13 +67,19 @@ fn set_control(c: &mut Controls, text: &str) -> Result<(), Failure> {
         "position-gain" => c.position_db = number()?.clamp(-60.0, 40.0),
         "bend-range" => c.bend_range_st = number()?.clamp(0.0, 48.0),
         "velocity-curve" => c.velocity_exponent = number()?.clamp(0.25, 4.0),
-        "dc-filter" => {
-            c.dc_filter = match value.trim() {
+        "dc-filter" | "mpe" => {
+            let on = match value.trim() {
                 "on" | "1" | "true" => true,
                 "off" | "0" | "false" => false,
-                v => return Err(usage(format!("--control dc-filter={v}: use on or off"))),
+                v => return Err(usage(format!("--control {name}={v}: use on or off"))),
+            };
+            if name.trim() == "mpe" {
+                c.mpe = on;
+            } else {
+                c.dc_filter = on;
             }
         }
+        "release" => c.release = number()?.clamp(0.0, 1.0),
         n if n.starts_with("macro") => {
             let slot: usize = n[5..]
                 .parse()
@@ -91,7 +97,7 @@ fn set_control(c: &mut Controls, text: &str) -> Result<(), Failure> {
             return Err(usage(format!(
                 "unknown control `{n}`; the controls are stiffness, damping, tune, \
                  output-gain, force-gain, position-gain, dc-filter, bend-range, \
-                 velocity-curve and macro1 … macro{}",
+                 velocity-curve, release, mpe and macro1 … macro{}",
                 instrument::NUM_MACROS
             )))
         }

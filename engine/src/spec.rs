@@ -538,6 +538,10 @@ pub struct HostSpec {
     pub macro_ranges: Vec<MacroRange>,
     /// `~voices N`: how many notes the model plays at once by default (1 … 1024).
     pub voices: Option<u32>,
+    /// `~pressure inK [AMOUNT]`: the input (1-based) that key pressure drives, and what full
+    /// pressure adds to it.
+    pub pressure_input: Option<u32>,
+    pub pressure_scale: Option<f64>,
 }
 
 impl ModelSpec {

@@ -145,7 +145,10 @@ fn main() {
                             cc: if block.is_multiple_of(2) { 64 } else { 74 },
                             value: 0.9,
                         },
-                        _ => Event::PitchBend { value: 0.7 },
+                        _ => Event::PitchBend {
+                            value: 0.7,
+                            channel: 0,
+                        },
                     };
                     Timed::new(k * 8, event)
                 });

@@ -304,3 +304,161 @@ fn drunk_triangles_play_100_overlapping_notes_and_free_their_voices() {
         "the voices whose masses rest must free themselves"
     );
 }
+
+fn on(note: u8, channel: u8, voice_id: Option<i32>) -> Event {
+    Event::NoteOn {
+        note,
+        velocity: 0.9,
+        channel,
+        voice_id,
+    }
+}
+
+#[test]
+fn an_mpe_bend_moves_only_its_channels_voice() {
+    let mpe = Controls {
+        mpe: true,
+        ..quiet()
+    };
+    // +12 semitones of the ±48 member range, sent before the note as MPE controllers do.
+    let up = Event::PitchBend {
+        value: 0.5 + 12.0 / 96.0,
+        channel: 2,
+    };
+    let bent = render(
+        STRUCK,
+        8,
+        mpe,
+        &[(0, on(60, 1, None)), (0, up), (0, on(67, 2, None))],
+        24_000,
+    )
+    .left;
+    let played = render(
+        STRUCK,
+        8,
+        mpe,
+        &[(0, on(60, 1, None)), (0, on(79, 2, None))],
+        24_000,
+    )
+    .left;
+    assert_eq!(bent, played, "bend +12 on channel 2 plays note 67 as 79");
+    // The other channel's voice does not move.
+    let alone = render(STRUCK, 8, mpe, &[(0, on(60, 1, None))], 24_000).left;
+    let with_other_bend = render(STRUCK, 8, mpe, &[(0, on(60, 1, None)), (100, up)], 24_000).left;
+    assert_eq!(
+        alone, with_other_bend,
+        "a bend on channel 2 must not move channel 1"
+    );
+    // Without MPE the same bend is global: ±2 semitones over the whole instrument.
+    let global = render(
+        STRUCK,
+        8,
+        quiet(),
+        &[(0, on(60, 1, None)), (100, up)],
+        24_000,
+    )
+    .left;
+    assert_ne!(alone, global);
+}
+
+#[test]
+fn note_expressions_retune_and_modulate_one_voice() {
+    let tune = |v: i32, st: f32| Event::Tuning {
+        semitones: st,
+        channel: 0,
+        note: None,
+        voice_id: Some(v),
+    };
+    // The CLAP tuning expression: +12 on voice 7 is note 72; voice 8 stays.
+    let tuned = render(
+        STRUCK,
+        8,
+        quiet(),
+        &[
+            (0, on(60, 0, Some(7))),
+            (0, tune(7, 12.0)),
+            (0, on(55, 0, Some(8))),
+        ],
+        24_000,
+    )
+    .left;
+    let played = render(
+        STRUCK,
+        8,
+        quiet(),
+        &[(0, on(72, 0, Some(7))), (0, on(55, 0, Some(8)))],
+        24_000,
+    )
+    .left;
+    assert_eq!(tuned, played);
+    // Polyphonic modulation: Stiffness +2 octaves on one voice is that voice at ×4.
+    let modulated = render(
+        DAMPED,
+        8,
+        quiet(),
+        &[
+            (0, on(60, 0, Some(3))),
+            (
+                0,
+                Event::Modulation {
+                    target: ressort_engine::instrument::events::Modulated::Stiffness,
+                    octaves: 2.0,
+                    voice_id: 3,
+                },
+            ),
+        ],
+        24_000,
+    )
+    .left;
+    let stiffer = render(
+        DAMPED,
+        8,
+        Controls {
+            stiffness_octaves: 2.0,
+            ..quiet()
+        },
+        &[(0, on(60, 0, Some(3)))],
+        24_000,
+    )
+    .left;
+    assert_eq!(modulated, stiffer);
+}
+
+#[test]
+fn pressure_pushes_the_scripts_pressure_input() {
+    // `~pressure in1 0.001`: full pressure is a sustained force of 0.001 on the oscillator,
+    // which settles at F/K = 0.05 units (× the output gain).
+    let script = format!("{DAMPED}~pressure in1 0.001\n");
+    let controls = Controls {
+        dc_filter: false,
+        ..quiet()
+    };
+    let press = Event::Pressure {
+        value: 1.0,
+        channel: 0,
+        note: Some(60),
+        voice_id: None,
+    };
+    let pressed = render(
+        &script,
+        8,
+        controls,
+        &[(0, Event::note_on(60, 0.0)), (0, press)],
+        96_000,
+    )
+    .left;
+    let gain = 10f64.powf(-12.0 / 20.0);
+    let settled = *pressed.last().unwrap() as f64 / gain;
+    println!("settled at {settled:.5} units (F/K = 0.05)");
+    assert!((settled - 0.05).abs() < 0.05 * 0.02, "{settled}");
+    // Channel pressure without MPE reaches the model itself too (no note needed).
+    let channel = Event::Pressure {
+        value: 0.5,
+        channel: 0,
+        note: None,
+        voice_id: None,
+    };
+    let mono = render(&script, 1, controls, &[(0, channel)], 96_000).left;
+    let settled = *mono.last().unwrap() as f64 / gain;
+    assert!((settled - 0.025).abs() < 0.025 * 0.02, "{settled}");
+}

@@ -11,6 +11,7 @@
 use model::{ModelStore, Prepared};
 use nice_plug::midi::{Channel, Key, VoiceID};
 use nice_plug::prelude::*;
+use ressort_engine::instrument::events::Modulated;
 use ressort_engine::instrument::{
     Controls, Event, Instrument, Timed, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS,
 };
@@ -247,7 +248,54 @@ fn instrument_event(event: NoteEvent<()>) -> Option<Timed> {
             channel: channel.number().unwrap_or(0),
             voice_id: voice_id.id(),
         },
-        NoteEvent::MidiPitchBend { value, .. } => Event::PitchBend { value },
+        NoteEvent::MidiPitchBend { value, channel, .. } => Event::PitchBend { value, channel },
+        NoteEvent::MidiChannelPressure {
+            channel, pressure, ..
+        } => Event::Pressure {
+            value: pressure,
+            channel,
+            note: None,
+            voice_id: None,
+        },
+        NoteEvent::PolyPressure {
+            voice_id,
+            channel,
+            key,
+            pressure,
+            ..
+        } => Event::Pressure {
+            value: pressure,
+            channel: channel.number().unwrap_or(0),
+            note: key.number(),
+            voice_id: voice_id.id(),
+        },
+        NoteEvent::PolyTuning {
+            voice_id,
+            channel,
+            key,
+            tuning,
+            ..
+        } => Event::Tuning {
+            semitones: tuning,
+            channel: channel.number().unwrap_or(0),
+            note: key.number(),
+            voice_id: voice_id.id(),
+        },
+        NoteEvent::PolyModulation {
+            voice_id,
+            poly_modulation_id,
+            normalized_offset,
+            ..
+        } => Event::Modulation {
+            target: match poly_modulation_id {
+                params::POLY_MOD_STIFFNESS => Modulated::Stiffness,
+                params::POLY_MOD_DAMPING => Modulated::Damping,
+                _ => return None,
+            },
+            // The knobs span 2 × GAIN_OCTAVES octaves.
+            octaves: normalized_offset * 2.0 * params::GAIN_OCTAVES,
+            voice_id,
+        },
         NoteEvent::MidiCC { cc, value, .. } => Event::Controller { cc, value },
         _ => return None,
     };
@@ -517,6 +565,11 @@ impl ClapPlugin for Ressort {
         Some("Mass-interaction physical modelling: masses, springs, contacts, plucks and bows");
     const CLAP_MANUAL_URL: Option<&'static str> = None;
     const CLAP_SUPPORT_URL: Option<&'static str> = None;
+    /// Stiffness and Damping take polyphonic modulation: a host can move them per voice.
+    const CLAP_POLY_MODULATION_CONFIG: Option<PolyModulationConfig> = Some(PolyModulationConfig {
+        max_voice_capacity: model::MAX_VOICES as u32,
+        supports_overlapping_voices: true,
+    });
     const CLAP_FEATURES: &'static [ClapFeature] = &[
         ClapFeature::Instrument,
         ClapFeature::Synthesizer,
@@ -542,8 +595,10 @@ impl Vst3Plugin for Ressort {
 /// The controllers VST3 hosts deliver (as proxy parameters on each of the 16 channels): pitch
 /// bend (129) and the controllers people put on knobs and pedals, for MIDI learn: modulation
 /// wheel 1, breath 2, foot 4, volume 7, expression 11, general purpose 16–19, sustain 64 and
-/// the sound controllers 71–74. CLAP and the standalone deliver every controller.
-pub const VST3_CONTROLLERS: [u8; 15] = [1, 2, 4, 7, 11, 16, 17, 18, 19, 64, 71, 72, 73, 74, 129];
+/// the sound controllers 71–74, and channel pressure (128, MPE's per-note pressure). CLAP and
+/// the standalone deliver every controller.
+pub const VST3_CONTROLLERS: [u8; 16] =
+    [1, 2, 4, 7, 11, 16, 17, 18, 19, 64, 71, 72, 73, 74, 128, 129];
 
 nice_export_clap!(Ressort);
 nice_export_vst3!(Ressort);

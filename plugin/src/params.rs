@@ -14,6 +14,10 @@ use std::sync::Arc;
 /// from ×1/16 to ×16 and automation lanes are linear in octaves.
 pub const GAIN_OCTAVES: f32 = 4.0;
 
+/// The polyphonic modulation ids of Stiffness and Damping (CLAP).
+pub const POLY_MOD_STIFFNESS: u32 = 0;
+pub const POLY_MOD_DAMPING: u32 = 1;
+
 /// The Velocity Curve's exponent spans 2^±this.
 pub const VELOCITY_OCTAVES: f32 = 2.0;
 /// The widest pitch-bend range (MPE's member channels use ±48).
@@ -73,6 +77,11 @@ pub struct RessortParams {
     /// The damper laid on a voice when its key goes up: 0 lets it ring.
     #[id = "release"]
     pub release: FloatParam,
+
+    /// MPE: channel 1 is the master channel, channels 2 … 16 carry one note each, with its
+    /// own bend (±48 semitones) and pressure.
+    #[id = "mpe"]
+    pub mpe: BoolParam,
 
     /// Semitones of a full pitch bend, up or down.
     #[id = "bend_range"]
@@ -136,6 +145,7 @@ impl RessortParams {
             dc_filter: self.dc_filter.value(),
             bend_range_st: self.bend_range.value() as f64,
             release: self.release.value() as f64,
+            mpe: self.mpe.value(),
             velocity_exponent: 2f64.powf(self.velocity_curve.value() as f64),
         }
     }
@@ -161,8 +171,8 @@ impl RessortParams {
         RessortParams {
             model,
             cc_map: Arc::new(CcMap::default()),
-            stiffness: factor_param("Stiffness"),
-            damping: factor_param("Damping"),
+            stiffness: factor_param("Stiffness").with_poly_modulation_id(POLY_MOD_STIFFNESS),
+            damping: factor_param("Damping").with_poly_modulation_id(POLY_MOD_DAMPING),
             tune: FloatParam::new(
                 "Tune",
                 0.0,
@@ -207,6 +217,7 @@ impl RessortParams {
                     }
                 }))
             },
+            mpe: BoolParam::new("MPE", Controls::DEFAULT.mpe),
             release: FloatParam::new(
                 "Release",
                 d.release as f32,

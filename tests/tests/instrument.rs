@@ -99,6 +99,7 @@ fn the_plugin_plays_what_the_instrument_plays() {
             2_003,
             Event::PitchBend {
                 value: bend_value(0.5),
+                channel: 0,
             },
         ),
         (

@@ -45,7 +45,7 @@ def routed_oscillator(source: str) -> str:
 STRIKE = -0.05
 
 #: The MIDI controllers the VST3 plugin lists as proxies (`VST3_CONTROLLERS` in the plugin).
-VST3_CONTROLLERS = [1, 2, 4, 7, 11, 16, 17, 18, 19, 64, 71, 72, 73, 74, "bend"]
+VST3_CONTROLLERS = [1, 2, 4, 7, 11, 16, 17, 18, 19, 64, 71, 72, 73, 74, "channel_pressure", "bend"]
 
 #: The plugin's own parameters (before the MIDI controller proxies).
 PARAMETERS = [
@@ -60,6 +60,7 @@ PARAMETERS = [
     "model_edits",
     "voices",
     "release",
+    "mpe",
     "bend_range_st",
     "velocity_curve",
 ] + [f"macro_{i}" for i in range(1, 17)]
@@ -91,11 +92,14 @@ def test_pedalboard_loads_the_plugin_with_its_parameters():
     # VST3 delivers MIDI controllers through hidden proxy parameters, one per controller and
     # channel: the plugin lists the ones MIDI learn offers and pitch bend, nothing else.
     proxies = names[len(PARAMETERS) :]
-    expected = [
-        f"midi_ch_{c}_cc_{cc}" if cc != "bend" else f"midi_ch_{c}_pitch_bend"
-        for c in range(1, 17)
-        for cc in VST3_CONTROLLERS
-    ]
+    def proxy(c, cc):
+        if cc == "bend":
+            return f"midi_ch_{c}_pitch_bend"
+        if cc == "channel_pressure":
+            return f"midi_ch_{c}_channel_pressure"
+        return f"midi_ch_{c}_cc_{cc}"
+
+    expected = [proxy(c, cc) for c in range(1, 17) for cc in VST3_CONTROLLERS]
     assert proxies == expected, proxies
     assert plugin.is_instrument
 

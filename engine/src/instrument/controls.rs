@@ -40,6 +40,10 @@ pub struct Controls {
     pub bend_range_st: f64,
     /// A note's strike is velocity^exponent (1: linear; above 1 soft notes are softer).
     pub velocity_exponent: f64,
+    /// MPE: MIDI channel 1 is the master channel (its bend moves every voice by the Bend
+    /// Range), channels 2 … 16 are member channels whose bend (±48 semitones) and pressure
+    /// move only their own voices.
+    pub mpe: bool,
     /// The damper a released voice gets, 0 … 1: its Damping gain × 16^release (0: it rings
     /// on as a struck object does).
     pub release: f64,
@@ -59,6 +63,7 @@ impl Controls {
         bend_range_st: 2.0,
         velocity_exponent: 1.0,
         release: 0.0,
+        mpe: false,
     };
 
     /// The smoothed controls as numbers, to notice automation between blocks. Non-finite
@@ -172,10 +177,23 @@ impl Smoothed {
     /// reference key, with the Damping gain asked for multiplied by `z_factor` (the Release
     /// damper of a released voice).
     pub fn gains(&self, view: &ClampView<'_>, note_st: f64, z_factor: f64) -> Gains {
+        self.gains_offset(view, note_st, z_factor, 0.0, 0.0)
+    }
+
+    /// [`Smoothed::gains`] with a voice's own modulation of Stiffness and Damping, in octaves
+    /// (CLAP polyphonic modulation).
+    pub fn gains_offset(
+        &self,
+        view: &ClampView<'_>,
+        note_st: f64,
+        z_factor: f64,
+        k_octaves: f64,
+        z_octaves: f64,
+    ) -> Gains {
         let semitones = self.tune.value + note_st;
         let tuning = tuning_gain(semitones, view.reference_pitch_hz, view.sample_rate);
-        let requested_k = 2f64.powf(self.stiffness.value) * tuning;
-        let requested_z = 2f64.powf(self.damping.value) * z_factor;
+        let requested_k = 2f64.powf(self.stiffness.value + k_octaves) * tuning;
+        let requested_z = 2f64.powf(self.damping.value + z_octaves) * z_factor;
         let mut moved = [(view.envelope, 0.0); NUM_MACROS];
         let mut n_moved = 0;
         for (slot, (binding, envs)) in view.macros.iter().zip(view.macro_envelopes).enumerate() {

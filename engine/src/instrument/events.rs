@@ -20,8 +20,32 @@ pub enum Event {
         channel: u8,
         voice_id: Option<i32>,
     },
-    /// Pitch bend, 0 … 1 with 0.5 at rest; scaled by the bend range.
-    PitchBend { value: f32 },
+    /// Pitch bend, 0 … 1 with 0.5 at rest, on MIDI channel `channel` (0 … 15). Scaled by the
+    /// Bend Range; with MPE on, a member channel's bend (channels 1 … 15) moves only the voices
+    /// of that channel, by ±[`MPE_MEMBER_BEND_ST`].
+    PitchBend { value: f32, channel: u8 },
+    /// Pressure, 0 … 1: of one note (`note`/`voice_id` set: polyphonic aftertouch, the CLAP
+    /// pressure expression) or of a channel (channel pressure; with MPE on, a member channel's
+    /// voices). It drives the script's `~pressure` input.
+    Pressure {
+        value: f32,
+        channel: u8,
+        note: Option<u8>,
+        voice_id: Option<i32>,
+    },
+    /// A note's own tuning in semitones (the CLAP tuning expression).
+    Tuning {
+        semitones: f32,
+        channel: u8,
+        note: Option<u8>,
+        voice_id: Option<i32>,
+    },
+    /// Polyphonic modulation of one voice's Stiffness or Damping, in octaves of the gain.
+    Modulation {
+        target: Modulated,
+        octaves: f32,
+        voice_id: i32,
+    },
     /// A strike without retuning (the editor's Strike and Audition), `velocity` 0 … 1,
     /// linear.
     Strike { velocity: f32 },
@@ -50,6 +74,16 @@ impl Event {
         }
     }
 }
+
+/// What a [`Event::Modulation`] moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Modulated {
+    Stiffness,
+    Damping,
+}
+
+/// The pitch-bend range of an MPE member channel (the MPE specification's default).
+pub const MPE_MEMBER_BEND_ST: f64 = 48.0;
 
 /// An event at sample `timing` of the block being processed.
 #[derive(Clone, Copy, Debug, PartialEq)]

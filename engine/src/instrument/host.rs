@@ -38,6 +38,10 @@ pub fn channel(source: RouteSource) -> Option<usize> {
     }
 }
 
+/// What full pressure adds to the `~pressure` input when the script gives no amount: a
+/// sustained force of 0.001 (or a position offset of 0.001 units).
+pub const DEFAULT_PRESSURE: f64 = 0.001;
+
 /// The plugin-facing settings of a model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HostSettings {
@@ -54,6 +58,10 @@ pub struct HostSettings {
     pub macro_ranges: Vec<MacroRange>,
     /// `~voices N`: the notes the model plays at once unless the host says otherwise.
     pub voices: Option<u32>,
+    /// `~pressure inK [AMOUNT]`: the input (0-based) that pressure drives, and what full
+    /// pressure adds to it (a force or a position offset, before the host gains).
+    pub pressure_input: Option<u32>,
+    pub pressure_scale: f64,
 }
 
 impl Default for HostSettings {
@@ -66,13 +74,15 @@ impl Default for HostSettings {
             reference_key: 60.0,
             macro_ranges: Vec::new(),
             voices: None,
+            pressure_input: None,
+            pressure_scale: DEFAULT_PRESSURE,
         }
     }
 }
 
 impl HostSettings {
     /// Reads the host directives of a parsed model (`~pitch`, `~key`, `~note`, `~route`,
-    /// `~macro`, `~voices`; see docs/LANGUAGE.md §12.3).
+    /// `~macro`, `~voices`, `~pressure`; see docs/LANGUAGE.md §12.3).
     pub fn from_spec(spec: &ModelSpec) -> Result<HostSettings, Vec<String>> {
         let h = &spec.host;
         let defaults = HostSettings::default();
@@ -92,6 +102,8 @@ impl HostSettings {
             reference_key: h.key.unwrap_or(defaults.reference_key),
             macro_ranges: h.macro_ranges.clone(),
             voices: h.voices,
+            pressure_input: h.pressure_input.map(|k| k - 1),
+            pressure_scale: h.pressure_scale.unwrap_or(defaults.pressure_scale),
         })
     }
 }

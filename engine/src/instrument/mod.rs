@@ -39,6 +39,7 @@ pub use prepare::{parse_script, peak_frequency, prepare, InputRole, Prepared, Re
 
 use crate::RouteSource;
 use controls::{ClampView, Smoothed};
+use events::Modulated;
 use output::{OutputStage, Span};
 pub use voices::{Ended, VoiceBank, VoiceState};
 
@@ -57,6 +58,22 @@ pub const MAX_HOST_INPUTS: usize = 10;
 /// Host output channels the instrument writes: main left and right (`@out1`, `@out2`), then
 /// `@out3` … `@out8` on auxiliary outputs.
 pub const MAX_HOST_OUTPUTS: usize = 8;
+
+/// A value in 0 … 1 (NaN reads 0).
+fn unit(v: f32) -> f64 {
+    if v.is_finite() {
+        (v as f64).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+fn push(list: &mut [usize; 64], n: &mut usize, i: usize) {
+    if *n < list.len() {
+        list[*n] = i;
+        *n += 1;
+    }
+}
 
 /// The sustain pedal's controller: it holds released voices.
 pub const SUSTAIN_CC: u8 = 64;
@@ -103,6 +120,14 @@ pub struct Instrument {
     /// Semitones from the reference key of the last note, and the pitch bend.
     note_st: f64,
     bend_st: f64,
+    /// The one model's own note tuning (semitones) and pressure (0 … 1); with voices, the
+    /// pressure that reaches the model itself (channel pressure without MPE).
+    tuning_st: f64,
+    pressure: f64,
+    /// With MPE, each member channel's last bend (semitones) and pressure: a note takes its
+    /// channel's values when it starts (controllers send them before the note-on).
+    channel_bend: [f64; 16],
+    channel_pressure: [f64; 16],
     /// The default host channel order for model inputs without a `~route`.
     order: &'static [RouteSource],
     /// Whether the model's watcher should publish (an open editor).
@@ -139,6 +164,10 @@ impl Instrument {
             output: OutputStage::new(sample_rate),
             note_st: 0.0,
             bend_st: 0.0,
+            tuning_st: 0.0,
+            pressure: 0.0,
+            channel_bend: [0.0; 16],
+            channel_pressure: [0.0; 16],
             order: host::default_order(false),
             watching: false,
             cc_map: [None; NUM_MACROS],
@@ -231,6 +260,10 @@ impl Instrument {
         self.fade_left = 0;
         self.note_st = 0.0;
         self.bend_st = 0.0;
+        self.tuning_st = 0.0;
+        self.pressure = 0.0;
+        self.channel_bend = [0.0; 16];
+        self.channel_pressure = [0.0; 16];
         self.controls = controls.sanitized();
         self.host_macros = self.controls.macros;
         self.cc_macros = [None; NUM_MACROS];
@@ -263,7 +296,7 @@ impl Instrument {
             return;
         };
         let Some(bank) = m.bank.as_mut() else {
-            self.gains = self.smoothed.apply(m, self.note_st);
+            self.gains = self.smoothed.apply(m, self.note_st + self.tuning_st);
             return;
         };
         let view = ClampView {
@@ -287,7 +320,13 @@ impl Instrument {
             } else {
                 1.0
             };
-            let g = self.smoothed.gains(&view, v.note_st, z);
+            let g = self.smoothed.gains_offset(
+                &view,
+                v.note_st + v.bend_st + v.tuning_st,
+                z,
+                v.mod_k,
+                v.mod_z,
+            );
             self.smoothed.set(&mut v.engine, view.macros, &g);
             if v.started > newest {
                 newest = v.started;
@@ -312,10 +351,120 @@ impl Instrument {
             macros: &m.macros,
             macro_envelopes: &m.macro_envelopes,
         };
+        let release = 16f64.powf(self.controls.release);
         let v = &mut bank.voices[i];
-        let g = self.smoothed.gains(&view, v.note_st, 1.0);
+        let z = if v.state == VoiceState::Released {
+            release
+        } else {
+            1.0
+        };
+        let g = self.smoothed.gains_offset(
+            &view,
+            v.note_st + v.bend_st + v.tuning_st,
+            z,
+            v.mod_k,
+            v.mod_z,
+        );
         self.smoothed.set(&mut v.engine, view.macros, &g);
         self.gains = g;
+    }
+
+    /// An expression event: MPE bend, pressure, note tuning, polyphonic modulation. Returns
+    /// whether the monophonic model's pitch changed (a chunk starts at its sample).
+    fn expression(&mut self, event: Event) -> bool {
+        let mpe = self.controls.mpe;
+        let Some(m) = self.current.as_deref_mut() else {
+            return false;
+        };
+        let Some(bank) = m.bank.as_mut() else {
+            // One model: pressure and tuning are the model's own.
+            return match event {
+                Event::Pressure { value, .. } => {
+                    self.pressure = unit(value);
+                    false
+                }
+                Event::Tuning { semitones, .. } if semitones.is_finite() => {
+                    self.tuning_st = semitones as f64;
+                    true
+                }
+                _ => false,
+            };
+        };
+        let mut retune = [0usize; 64];
+        let mut n = 0;
+        match event {
+            Event::PitchBend { value, channel } => {
+                let st = events::bend_semitones(value, events::MPE_MEMBER_BEND_ST);
+                self.channel_bend[channel as usize % 16] = st;
+                for i in 0..bank.voices.len() {
+                    if !bank.addresses(i, None, None, channel) {
+                        continue;
+                    }
+                    bank.voices[i].bend_st = st;
+                    push(&mut retune, &mut n, i);
+                }
+            }
+            Event::Pressure {
+                value,
+                channel,
+                note,
+                voice_id,
+            } => {
+                let v = unit(value);
+                if note.is_none() && voice_id.is_none() && !(mpe && channel != 0) {
+                    // Channel pressure without MPE: every voice, and the model itself.
+                    self.pressure = v;
+                    for voice in bank.voices.iter_mut() {
+                        voice.pressure = v;
+                    }
+                } else {
+                    if note.is_none() && voice_id.is_none() {
+                        self.channel_pressure[channel as usize % 16] = v;
+                    }
+                    for i in 0..bank.voices.len() {
+                        if !bank.addresses(i, voice_id, note, channel) {
+                            continue;
+                        }
+                        bank.voices[i].pressure = v;
+                    }
+                }
+            }
+            Event::Tuning {
+                semitones,
+                channel,
+                note,
+                voice_id,
+            } if semitones.is_finite() => {
+                for i in 0..bank.voices.len() {
+                    if !bank.addresses(i, voice_id, note, channel) {
+                        continue;
+                    }
+                    bank.voices[i].tuning_st = semitones as f64;
+                    push(&mut retune, &mut n, i);
+                }
+            }
+            Event::Modulation {
+                target,
+                octaves,
+                voice_id,
+            } if octaves.is_finite() => {
+                for i in 0..bank.voices.len() {
+                    if !bank.addresses(i, Some(voice_id), None, 0) {
+                        continue;
+                    }
+                    match target {
+                        Modulated::Stiffness => bank.voices[i].mod_k = octaves as f64,
+                        Modulated::Damping => bank.voices[i].mod_z = octaves as f64,
+                    }
+                    push(&mut retune, &mut n, i);
+                }
+            }
+            _ => {}
+        }
+        for &i in &retune[..n] {
+            self.apply_voice(i);
+        }
+        false
     }
 
     /// Voices sounding and the bank's size (1 and 1 without a bank).
@@ -408,6 +557,11 @@ impl Instrument {
                             if let Some(bank) = m.bank.as_mut() {
                                 // A voice of its own, tuned before its first sample.
                                 let i = bank.note_on(note, channel, voice_id, note_st, response);
+                                let c = channel as usize % 16;
+                                if self.controls.mpe && c != 0 {
+                                    bank.voices[i].bend_st = self.channel_bend[c];
+                                    bank.voices[i].pressure = self.channel_pressure[c];
+                                }
                                 self.apply_voice(i);
                             } else {
                                 self.note_st = note_st;
@@ -428,11 +582,19 @@ impl Instrument {
                     Event::Strike { velocity } => {
                         strike += events::velocity_response(velocity, 1.0);
                     }
-                    Event::PitchBend { value } => {
-                        self.bend_st = events::bend_semitones(value, self.controls.bend_range_st);
+                    Event::PitchBend { value, channel } => {
+                        if self.controls.mpe && channel != 0 {
+                            retuned |= self.expression(e.event);
+                        } else {
+                            self.bend_st =
+                                events::bend_semitones(value, self.controls.bend_range_st);
+                        }
                     }
                     Event::Controller { cc, value } => {
                         automated |= self.controller(cc, value);
+                    }
+                    Event::Pressure { .. } | Event::Tuning { .. } | Event::Modulation { .. } => {
+                        retuned |= self.expression(e.event);
                     }
                 }
                 next = events.next();
@@ -459,7 +621,7 @@ impl Instrument {
         // A call of zero frames: its events change the pitch state only.
         while let Some(e) = next {
             match e.event {
-                Event::PitchBend { value } => {
+                Event::PitchBend { value, channel } if !(self.controls.mpe && channel != 0) => {
                     self.bend_st = events::bend_semitones(value, self.controls.bend_range_st);
                 }
                 Event::NoteOn { note, .. } => {
@@ -532,6 +694,16 @@ impl Instrument {
             m.fill_inputs(&self.host_in, self.order, len, force, position);
             let n_in = m.roles.len();
             let n_out = m.outputs.len() / CHUNK;
+            // Pressure: a sustained push on the script's `~pressure` input.
+            let pressure = m.pressure_gain(force, position);
+            if let Some((k, gain)) = pressure {
+                let add = self.pressure * gain;
+                if add != 0.0 {
+                    m.inputs[k * len..(k + 1) * len]
+                        .iter_mut()
+                        .for_each(|x| *x += add);
+                }
+            }
             if let Some(bank) = m.bank.as_mut() {
                 // The model itself keeps playing what the host feeds it (a sidechain strikes
                 // it as without voices); notes play on voices of their own, which hear the
@@ -547,6 +719,7 @@ impl Instrument {
                     &mut m.outputs[..n_out * len],
                     m.note_input,
                     strike_force,
+                    pressure,
                 );
                 bank.free_silent(len);
                 if let Some(w) = m.watcher.as_mut() {
@@ -585,6 +758,7 @@ impl Instrument {
                     &mut old.outputs[..n_out * len],
                     None,
                     0.0,
+                    None,
                 );
             }
         }

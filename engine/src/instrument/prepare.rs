@@ -348,6 +348,21 @@ impl Prepared {
         });
     }
 
+    /// The script's `~pressure` input and the amount full pressure adds to it, in the
+    /// input's units after the host gains: × Force Gain (and the force rate scale) for a
+    /// force input, × Position Gain for a position input.
+    pub fn pressure_gain(&self, force: f64, position: f64) -> Option<(usize, f64)> {
+        let k = self.settings.pressure_input? as usize;
+        let scale = self.settings.pressure_scale;
+        let gain = match self.roles.get(k)? {
+            InputRole::Force => scale * force * self.force_scale,
+            InputRole::Position => scale * position,
+            InputRole::AudioParam => scale,
+            InputRole::Unused => return None,
+        };
+        Some((k, gain))
+    }
+
     /// How many notes play at once.
     pub fn voices(&self) -> usize {
         self.bank.as_ref().map_or(1, |b| b.limit)

@@ -48,6 +48,13 @@ pub struct Voice {
     pub voice_id: Option<i32>,
     /// Semitones from the reference key.
     pub note_st: f64,
+    /// The voice's own expression: MPE member bend and note tuning (semitones), pressure
+    /// (0 … 1), and the polyphonic modulation of Stiffness and Damping (octaves).
+    pub bend_st: f64,
+    pub tuning_st: f64,
+    pub pressure: f64,
+    pub mod_k: f64,
+    pub mod_z: f64,
     /// The key went up while the sustain pedal was down.
     pub pedal_held: bool,
     /// When it started, to tell old voices from new.
@@ -112,6 +119,11 @@ impl VoiceBank {
             channel: 0,
             voice_id: None,
             note_st: 0.0,
+            bend_st: 0.0,
+            tuning_st: 0.0,
+            pressure: 0.0,
+            mod_k: 0.0,
+            mod_z: 0.0,
             pedal_held: false,
             started: 0,
             quiet: 0,
@@ -189,6 +201,11 @@ impl VoiceBank {
         v.channel = channel;
         v.voice_id = voice_id;
         v.note_st = note_st;
+        v.bend_st = 0.0;
+        v.tuning_st = 0.0;
+        v.pressure = 0.0;
+        v.mod_k = 0.0;
+        v.mod_z = 0.0;
         v.pedal_held = false;
         v.started = self.clock;
         v.quiet = 0;
@@ -198,6 +215,27 @@ impl VoiceBank {
         v.fade_step = 0.0;
         v.strike = strike;
         slot
+    }
+
+    /// Whether an expression addresses voice `i`: by the host's voice id when both have one,
+    /// else by note and channel, else (a channel event) every voice of the channel. Free
+    /// voices and stolen ones are never addressed.
+    pub fn addresses(
+        &self,
+        i: usize,
+        voice_id: Option<i32>,
+        note: Option<u8>,
+        channel: u8,
+    ) -> bool {
+        let v = &self.voices[i];
+        let live = matches!(v.state, VoiceState::Held | VoiceState::Released);
+        let hit = match (voice_id, note) {
+            (Some(id), _) if v.voice_id.is_some() => v.voice_id == Some(id),
+            (_, Some(n)) => v.note == n && v.channel == channel,
+            (Some(_), None) => false,
+            (None, None) => v.channel == channel,
+        };
+        live && hit
     }
 
     /// A key went up: its held voices are released (held on while the pedal is down).
@@ -296,6 +334,8 @@ impl VoiceBank {
     /// model's planar input scratch) plus its own strike, and the voices' outputs are added
     /// to `outputs` (planar, `n_out` channels). A strike enters the note input × `strike_force`.
     /// Returns whether a voice's guard tripped (that voice is freed).
+    /// A voice's pressure adds `pressure × pressure_gain` to input `pressure_input` at every
+    /// sample (the script's `~pressure`).
     pub fn process(
         &mut self,
         len: usize,
@@ -303,6 +343,7 @@ impl VoiceBank {
         outputs: &mut [f64],
         note_input: Option<usize>,
         strike_force: f64,
+        pressure: Option<(usize, f64)>,
     ) -> bool {
         let mut tripped = false;
         for i in 0..self.voices.len() {
@@ -318,6 +359,14 @@ impl VoiceBank {
                     vin[k * len] += v.strike * strike_force;
                 }
                 v.strike = 0.0;
+            }
+            if let Some((k, gain)) = pressure.filter(|(k, _)| *k < n_in) {
+                let add = v.pressure * gain;
+                if add != 0.0 {
+                    vin[k * len..(k + 1) * len]
+                        .iter_mut()
+                        .for_each(|x| *x += add);
+                }
             }
             let vout = &mut v.outputs[..outputs.len()];
             let report = v.engine.process(len, vin, vout);
@@ -354,6 +403,11 @@ impl VoiceBank {
         for i in 0..self.voices.len() {
             let v = &mut self.voices[i];
             if !matches!(v.state, VoiceState::Held | VoiceState::Released) {
+                continue;
+            }
+            if v.pressure > 0.0 {
+                // A key that still presses drives its voice: it stays.
+                v.quiet = 0;
                 continue;
             }
             let x = v.engine.positions();

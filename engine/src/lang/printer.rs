@@ -402,6 +402,16 @@ pub fn print(spec: &ModelSpec) -> String {
     if let Some(v) = h.voices {
         let _ = writeln!(out, "~voices {v}");
     }
+    if let Some(k) = h.pressure_input {
+        match h.pressure_scale {
+            Some(a) => {
+                let _ = writeln!(out, "~pressure in{k} {}", format_number(a));
+            }
+            None => {
+                let _ = writeln!(out, "~pressure in{k}");
+            }
+        }
+    }
     if let Some(v) = h.key {
         let _ = writeln!(out, "~key {}", format_number(v));
     }

@@ -35,7 +35,7 @@ impl Builder<'_> {
         };
         if matches!(
             name.as_str(),
-            "pitch" | "key" | "note" | "route" | "macro" | "voices"
+            "pitch" | "key" | "note" | "route" | "macro" | "voices" | "pressure"
         ) {
             self.host_directive(item, &name, first.col, args);
             return;
@@ -52,7 +52,7 @@ impl Builder<'_> {
                     )
                     .with_expected(
                         "~begin, ~end, ~samplerate, ~generate, ~pitch, ~key, ~note, ~route, \
-                         ~macro or ~voices",
+                         ~macro, ~voices or ~pressure",
                     )
                     .with_found(format!("~{name}")),
                 );
@@ -186,6 +186,10 @@ impl Builder<'_> {
             "pitch" => ("a frequency in Hz (a positive number)", &[1]),
             "key" => ("a MIDI key number, 0 to 127", &[1]),
             "voices" => ("a number of voices, 1 to 1024", &[1]),
+            "pressure" => (
+                "an input (`in1`…) and optionally what full pressure adds to it",
+                &[1, 2],
+            ),
             "note" => (
                 "an input (`in1`…) and optionally the force of a full-velocity note",
                 &[1, 2],
@@ -225,6 +229,7 @@ impl Builder<'_> {
             |t: &Token| -> Option<f64> { t.string().parse::<f64>().ok().filter(|v| v.is_finite()) };
         let input = |t: &Token| -> Option<u32> {
             let s = t.string();
+            let s = s.strip_prefix('@').unwrap_or(&s);
             let digits = s.strip_prefix("in")?;
             if digits.starts_with('0') || digits.is_empty() {
                 return None;
@@ -241,8 +246,8 @@ impl Builder<'_> {
                 format!("a second `~{name}` for {what}"),
             ));
         };
-        // `~note` and `~route` start with an input.
-        let k = if matches!(name, "note" | "route") {
+        // `~note`, `~route` and `~pressure` start with an input (`@in1` reads as `in1`).
+        let k = if matches!(name, "note" | "route" | "pressure") {
             let Some(k) = input(&args[0]) else {
                 bad(
                     &mut self.diags,
@@ -312,6 +317,29 @@ impl Builder<'_> {
                 }
                 host.note_input = Some(k);
                 host.note_force = force;
+            }
+            "pressure" => {
+                let amount = match args.get(1) {
+                    Some(t) => match number(t) {
+                        Some(v) => Some(v),
+                        None => {
+                            bad(
+                                &mut self.diags,
+                                t.col,
+                                "the pressure amount must be a number".into(),
+                                Some(t.source()),
+                            );
+                            return;
+                        }
+                    },
+                    None => None,
+                };
+                if host.pressure_input.is_some() {
+                    conflict(&mut self.diags, "the model");
+                    return;
+                }
+                host.pressure_input = Some(k);
+                host.pressure_scale = amount;
             }
             "route" => {
                 let Some(source) = RouteSource::from_name(&args[1].string()) else {
