@@ -101,9 +101,10 @@ pub fn summary(path: &Path, spec: &ModelSpec, engine: &Engine, report: &Stabilit
         .iter()
         .map(|p| match p.kind {
             ParamKind::Control { value } => format!("{} = {value}", p.name),
-            ParamKind::Audio { input, default } if default == 0.0 => {
-                format!("{} ← in{input}", p.name)
-            }
+            ParamKind::Audio {
+                input,
+                default: 0.0,
+            } => format!("{} ← in{input}", p.name),
             ParamKind::Audio { input, default } => format!("{} ← {default} + in{input}", p.name),
         })
         .collect();
