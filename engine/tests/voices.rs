@@ -462,3 +462,20 @@ fn pressure_pushes_the_scripts_pressure_input() {
     let settled = *mono.last().unwrap() as f64 / gain;
     assert!((settled - 0.025).abs() < 0.025 * 0.02, "{settled}");
 }
+
+#[test]
+fn the_editors_strike_plays_a_voice() {
+    // Strike and Audition send a strike without a note: with voices it plays the reference key
+    // on a voice of its own, as a note at that key does.
+    let struck = render(
+        STRUCK,
+        8,
+        quiet(),
+        &[(0, Event::Strike { velocity: 0.8 })],
+        12_000,
+    );
+    let played = render(STRUCK, 8, quiet(), &[(0, Event::note_on(60, 0.8))], 12_000);
+    assert!(peak(&struck.left) > 1e-3);
+    assert_eq!(struck.sounding[0], 1);
+    assert_eq!(struck.left, played.left);
+}

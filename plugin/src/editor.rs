@@ -296,7 +296,7 @@ impl EditorApp {
         }
         let other = ["B", "A"][compare.active];
         if ui
-            .small_button(format!("→{other}"))
+            .small_button(format!("copy to {other}"))
             .on_hover_text(format!("Copy the running script into slot {other}"))
             .clicked()
         {

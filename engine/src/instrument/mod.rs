@@ -580,7 +580,20 @@ impl Instrument {
                         }
                     }
                     Event::Strike { velocity } => {
-                        strike += events::velocity_response(velocity, 1.0);
+                        let response = events::velocity_response(velocity, 1.0);
+                        let bank = self.current.as_deref_mut().and_then(|m| {
+                            let key = m.settings.reference_key.round().clamp(0.0, 127.0) as u8;
+                            let note_st = key as f64 - m.settings.reference_key;
+                            m.bank.as_mut().map(|b| (b, key, note_st))
+                        });
+                        match bank {
+                            // With voices, a strike plays the reference key on a voice.
+                            Some((bank, key, note_st)) => {
+                                let i = bank.note_on(key, 0, None, note_st, response);
+                                self.apply_voice(i);
+                            }
+                            None => strike += response,
+                        }
                     }
                     Event::PitchBend { value, channel } => {
                         if self.controls.mpe && channel != 0 {
