@@ -28,6 +28,7 @@ pub mod host;
 pub mod macros;
 pub mod output;
 pub mod prepare;
+pub mod units;
 pub mod voices;
 
 pub use controls::{Controls, Gains};

@@ -1,0 +1,341 @@
+//! Macro slots in musical units. A slot bound to a stiffness reads as the frequency it gives
+//! the model's reference mode, a damping as that mode's T60, a connection-point coordinate as
+//! 0 … 1 and a mass as a ratio of the declared mass; anything else as its per-step value. The
+//! per-step value stays readable (`K = 0.12` is still understood, and the editor shows it).
+//!
+//! What a parameter is comes from the stability analysis (spec §5.2): moving it changes the
+//! masses' M, or their attached stiffness K_eq, or damping Z_eq. The frequencies and decays
+//! come from the modal analysis ([`crate::modes`]) at a few slot positions, and are
+//! interpolated between them: geometric in the value between the slot's ends, so piecewise
+//! log-linear, as the frequency of a mode is in its stiffness.
+
+use super::macros::MacroBinding;
+use crate::{Engine, StabilityReport};
+
+/// How a macro slot's value reads.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MacroUnit {
+    /// The per-step value: `NAME = 0.1200`.
+    Value,
+    /// A connection-point coordinate: `NAME = 0.300` along the structure.
+    Position,
+    /// A mass: `NAME ×2.00` of the declared value.
+    MassRatio,
+    /// A stiffness: the reference mode's frequency, `NAME: 312 Hz`.
+    Frequency(UnitTable),
+    /// A damping: the reference mode's decay, `NAME: T60 2.35 s`.
+    Decay(UnitTable),
+}
+
+/// A quantity at slot positions, increasing in position; positive values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UnitTable {
+    /// (slot position 0 … 1, value), by position.
+    pub points: Vec<(f64, f64)>,
+}
+
+impl UnitTable {
+    /// The value at slot position `n`: log-linear between the table's positions.
+    pub fn at(&self, n: f64) -> f64 {
+        let p = &self.points;
+        let n = n.clamp(0.0, 1.0);
+        let i = p
+            .windows(2)
+            .position(|w| n <= w[1].0)
+            .unwrap_or(p.len().saturating_sub(2));
+        let (a, b) = (p[i], p[(i + 1).min(p.len() - 1)]);
+        if b.0 <= a.0 {
+            return a.1;
+        }
+        let t = (n - a.0) / (b.0 - a.0);
+        if t <= 0.0 {
+            a.1
+        } else if t >= 1.0 {
+            b.1
+        } else {
+            (a.1.ln() + t * (b.1.ln() - a.1.ln())).exp()
+        }
+    }
+
+    /// The slot position whose value is `v` (bisection; the table is monotone), clamped to
+    /// the ends.
+    pub fn position_of(&self, v: f64) -> f64 {
+        let (lo_v, hi_v) = (self.at(0.0), self.at(1.0));
+        let rising = hi_v >= lo_v;
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if (self.at(mid) < v) == rising {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    fn is_monotone(&self) -> bool {
+        let p = &self.points;
+        let up = p.windows(2).all(|w| w[1].1 >= w[0].1);
+        let down = p.windows(2).all(|w| w[1].1 <= w[0].1);
+        (up || down) && p.iter().all(|x| x.1 > 0.0 && x.1.is_finite())
+    }
+}
+
+/// What moving a parameter changes, by the stability analysis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    Mass,
+    Stiffness,
+    Damping,
+    Other,
+}
+
+fn sums(r: &StabilityReport) -> (f64, f64, f64) {
+    r.masses.iter().fold((0.0, 0.0, 0.0), |(m, k, z), s| {
+        (m + s.m, k + s.k_eq, z + s.z_eq)
+    })
+}
+
+/// What the parameter of `b` is: the masses, stiffness or damping its value moves (the
+/// largest relative change wins). The engine is left at the declared value.
+pub fn role(engine: &mut Engine, b: &MacroBinding) -> Role {
+    let base = sums(&engine.stability());
+    let other = if b.max != b.default { b.max } else { b.min };
+    if other == b.default || engine.set_param(b.param, other).is_err() {
+        return Role::Other;
+    }
+    let moved = sums(&engine.stability());
+    let _ = engine.set_param(b.param, b.default);
+    engine.apply_pending_changes();
+    let rel = |a: f64, b: f64| (b - a).abs() / a.abs().max(1e-300);
+    let changes = [
+        (rel(base.0, moved.0), Role::Mass),
+        (rel(base.1, moved.1), Role::Stiffness),
+        (rel(base.2, moved.2), Role::Damping),
+    ];
+    changes
+        .iter()
+        .filter(|c| c.0 > 1e-12)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(Role::Other, |c| c.1)
+}
+
+/// Slot positions at which the reference mode is measured.
+const TABLE_POSITIONS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+
+/// The unit of slot `b`. `reference(engine)` measures the reference mode of the engine as it
+/// stands: (frequency in Hz, T60 in s), or None where the analysis does not apply; it is
+/// called at a few slot positions for a stiffness or damping. The engine is left at the
+/// declared value.
+pub fn unit_of(
+    engine: &mut Engine,
+    b: &MacroBinding,
+    coordinate: bool,
+    reference: &mut dyn FnMut(&mut Engine) -> Option<(f64, f64)>,
+) -> MacroUnit {
+    if coordinate {
+        return MacroUnit::Position;
+    }
+    let role = role(engine, b);
+    let table = |engine: &mut Engine,
+                 pick: fn((f64, f64)) -> f64,
+                 reference: &mut dyn FnMut(&mut Engine) -> Option<(f64, f64)>|
+     -> Option<UnitTable> {
+        let mut points = Vec::with_capacity(TABLE_POSITIONS.len());
+        for n in TABLE_POSITIONS {
+            engine.set_param(b.param, b.value_at(n)).ok()?;
+            engine.apply_pending_changes();
+            let v = reference(engine).map(pick);
+            match v {
+                Some(v) if v.is_finite() && v > 0.0 => points.push((n, v)),
+                _ => {
+                    let _ = engine.set_param(b.param, b.default);
+                    engine.apply_pending_changes();
+                    return None;
+                }
+            }
+        }
+        let _ = engine.set_param(b.param, b.default);
+        engine.apply_pending_changes();
+        let t = UnitTable { points };
+        t.is_monotone().then_some(t)
+    };
+    match role {
+        Role::Mass if b.default > 0.0 => MacroUnit::MassRatio,
+        Role::Stiffness => {
+            table(engine, |r| r.0, reference).map_or(MacroUnit::Value, MacroUnit::Frequency)
+        }
+        Role::Damping => {
+            table(engine, |r| r.1, reference).map_or(MacroUnit::Value, MacroUnit::Decay)
+        }
+        _ => MacroUnit::Value,
+    }
+}
+
+/// Four significant digits, without exponent for ordinary magnitudes.
+pub fn format_value(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        format!("{v:.3e}")
+    } else {
+        let digits = if a >= 1.0 {
+            3 - a.log10().floor() as i32
+        } else {
+            4
+        };
+        format!("{v:.*}", digits.clamp(0, 6) as usize)
+    }
+}
+
+/// A frequency with three or four significant digits: `312 Hz`, `1.25 kHz`.
+fn format_hz(f: f64) -> String {
+    if f >= 1000.0 {
+        format!("{:.3} kHz", f / 1000.0)
+    } else if f >= 100.0 {
+        format!("{f:.1} Hz")
+    } else {
+        format!("{f:.2} Hz")
+    }
+}
+
+fn format_seconds(t: f64) -> String {
+    if t >= 100.0 {
+        format!("{t:.0} s")
+    } else if t >= 10.0 {
+        format!("{t:.1} s")
+    } else if t >= 0.01 {
+        format!("{t:.3} s")
+    } else {
+        format!("{:.2} ms", t * 1000.0)
+    }
+}
+
+impl MacroUnit {
+    /// The slot's text at position `n`.
+    pub fn text(&self, b: &MacroBinding, n: f64) -> String {
+        let v = b.value_at(n);
+        match self {
+            MacroUnit::Value => format!("{} = {}", b.name, format_value(v)),
+            MacroUnit::Position => format!("{} = {:.3}", b.name, v),
+            MacroUnit::MassRatio => format!("{} ×{:.3}", b.name, v / b.default),
+            MacroUnit::Frequency(t) => format!("{}: {}", b.name, format_hz(t.at(n))),
+            MacroUnit::Decay(t) => format!("{}: T60 {}", b.name, format_seconds(t.at(n))),
+        }
+    }
+
+    /// The slot position a typed text asks for: the unit's own form (`312 Hz`, `1.2 kHz`,
+    /// `T60 2.5 s`, `450 ms`, `×2`) or the per-step value (`K = 0.12`, `0.12`).
+    pub fn position_of(&self, b: &MacroBinding, text: &str) -> Option<f64> {
+        let t = text.trim().replace(['\u{2212}'], "-");
+        let body = t
+            .strip_prefix(b.name.as_str())
+            .map(|r| r.trim_start_matches([':', ' ']))
+            .unwrap_or(&t)
+            .trim();
+        let lower = body.to_ascii_lowercase();
+        let num = |s: &str| s.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+        match self {
+            MacroUnit::Frequency(table) => {
+                if let Some(k) = lower.strip_suffix("khz").and_then(num) {
+                    return Some(table.position_of(k * 1000.0));
+                }
+                if let Some(h) = lower.strip_suffix("hz").and_then(num) {
+                    return Some(table.position_of(h));
+                }
+            }
+            MacroUnit::Decay(table) => {
+                let l = lower.trim_start_matches("t60").trim();
+                if let Some(ms) = l.strip_suffix("ms").and_then(num) {
+                    return Some(table.position_of(ms / 1000.0));
+                }
+                if let Some(s) = l.strip_suffix('s').and_then(num) {
+                    return Some(table.position_of(s));
+                }
+            }
+            MacroUnit::MassRatio => {
+                let r = lower.trim_start_matches(['×', 'x', '*']);
+                if r.len() != lower.len() {
+                    return num(r).map(|r| b.normalized_of(r * b.default));
+                }
+            }
+            MacroUnit::Value | MacroUnit::Position => {}
+        }
+        // The per-step value: `K = 0.12`, `= 0.12`, `0.12`.
+        let value = body.trim_start_matches('=').trim();
+        num(value).map(|v| b.normalized_of(v))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ParamId;
+
+    fn binding() -> MacroBinding {
+        MacroBinding {
+            param: ParamId(0),
+            name: "K".into(),
+            default: 0.1,
+            min: 0.025,
+            max: 0.4,
+        }
+    }
+
+    #[test]
+    fn tables_interpolate_and_invert() {
+        let t = UnitTable {
+            points: vec![(0.0, 100.0), (0.5, 200.0), (1.0, 400.0)],
+        };
+        assert!((t.at(0.25) - 141.421356).abs() < 1e-4, "log-linear");
+        assert_eq!(t.at(2.0), 400.0);
+        for n in [0.0, 0.1, 0.5, 0.77, 1.0] {
+            assert!((t.position_of(t.at(n)) - n).abs() < 1e-9);
+        }
+        let falling = UnitTable {
+            points: vec![(0.0, 4.0), (0.5, 2.0), (1.0, 1.0)],
+        };
+        assert!((falling.position_of(2.0) - 0.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn texts_read_back() {
+        let b = binding();
+        let f = MacroUnit::Frequency(UnitTable {
+            points: vec![(0.0, 110.0), (0.5, 220.0), (1.0, 440.0)],
+        });
+        assert_eq!(f.text(&b, 0.5), "K: 220.0 Hz");
+        assert_eq!(f.text(&b, 1.0), "K: 440.0 Hz");
+        for typed in ["K: 220.0 Hz", "220 hz", "0.22 kHz", "K = 0.1", "0.1"] {
+            let n = f.position_of(&b, typed).unwrap();
+            assert!((n - 0.5).abs() < 1e-6, "{typed}: {n}");
+        }
+        let d = MacroUnit::Decay(UnitTable {
+            points: vec![(0.0, 8.0), (0.5, 2.0), (1.0, 0.5)],
+        });
+        assert_eq!(d.text(&b, 0.5), "K: T60 2.000 s");
+        for typed in ["K: T60 2.000 s", "2 s", "2000 ms", "T60 2s"] {
+            assert!(
+                (d.position_of(&b, typed).unwrap() - 0.5).abs() < 1e-6,
+                "{typed}"
+            );
+        }
+        let m = MacroUnit::MassRatio;
+        assert_eq!(m.text(&b, 1.0), "K ×4.000");
+        assert!((m.position_of(&b, "×4").unwrap() - 1.0).abs() < 1e-9);
+        assert!((m.position_of(&b, "x1").unwrap() - 0.5).abs() < 1e-9);
+        let v = MacroUnit::Value;
+        assert_eq!(v.text(&b, 0.5), "K = 0.1000");
+        assert_eq!(v.position_of(&b, "K = 0.1000"), Some(0.5));
+        assert_eq!(v.position_of(&b, "nonsense"), None);
+        // Text → position → text is stable.
+        for u in [&f, &d, &m, &v] {
+            for i in 0..=20 {
+                let n = i as f64 / 20.0;
+                let text = u.text(&b, n);
+                let back = u.position_of(&b, &text).unwrap();
+                assert_eq!(u.text(&b, back), text, "{u:?} at {n}");
+            }
+        }
+    }
+}
