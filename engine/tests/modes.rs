@@ -355,3 +355,43 @@ fn note_names_round_trip() {
     assert!(rel(note_frequency("eb2").unwrap(), 77.78174593052023) < 1e-12);
     assert!(note_frequency("H2").is_none());
 }
+
+/// Undamped fixed-fixed string: stable iff g·λ_max < 4 with λ_max = 4(K/M)·sin²(Nπ/2(N+1)),
+/// so the exact limit is g = M / (K·sin²(Nπ/2(N+1))).
+#[test]
+fn exact_limit_of_an_undamped_string_is_the_closed_form() {
+    let mut e = engine(
+        &spec("@s string 17 2. 0.5 0. 0. 0.\n@in1 frcInput [@s 0.3]\n@out1 posOutput [@s 0.6]\n"),
+        44_100.0,
+    );
+    let n = 15.0;
+    let expect = 2.0 / (0.5 * (n * PI / (2.0 * (n + 1.0))).sin().powi(2));
+    let g = e.exact_stability().max_stiffness(1.0).unwrap();
+    assert!(rel(g, expect) < 1e-9, "{g} vs {expect}");
+    // The Damping gain does not matter without damping; with no stiffness, no limit on it.
+    assert!(rel(e.exact_stability().max_stiffness(5.0).unwrap(), expect) < 1e-9);
+    assert!(e.exact_stability().max_damping(1.0).unwrap().is_infinite());
+}
+
+/// On every preset the exact limit applies and is at least the Gershgorin bound (a diagonally
+/// dominant 4M − K − 2Z is positive definite).
+#[test]
+fn exact_limit_is_never_below_the_gershgorin_bound_on_the_presets() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".mdl"))
+        .collect();
+    names.sort();
+    for name in names {
+        let mut e = engine(&preset(&name), 44_100.0);
+        let gersh = e.gershgorin_stiffness_limit(1.0);
+        let StiffnessLimit::Exact(exact) = e.stiffness_limit(1.0) else {
+            panic!("{name}: the exact analysis does not apply");
+        };
+        eprintln!("{name}: Gershgorin ×{gersh:.4}, exact ×{exact:.4}");
+        assert!(exact >= gersh * (1.0 - 1e-9), "{name}: {exact} < {gersh}");
+    }
+}

@@ -118,16 +118,28 @@ impl ModalAnalysis {
             .map_or(0.0, |m| m.gains[i * self.num_outputs + o])
     }
 
-    /// The strongest mode above `min_hz` from `input` to `output` (1-based channels).
+    /// The strongest mode above `min_hz` from `input` to `output` (1-based channels). The
+    /// copies of a repeated mode (the pairs of square plates) split their gain in a way that
+    /// depends on the basis the solver chose, so they count together, by the sum of their
+    /// gains (a bound of their joint amplitude).
     pub fn strongest(&self, input: usize, output: usize, min_hz: f64) -> Option<&Mode> {
-        let best = (0..self.modes.len())
-            .filter(|&k| self.modes[k].frequency_hz >= min_hz)
-            .filter(|&k| self.gain(k, input, output).is_finite())
-            .max_by(|&a, &b| {
-                self.gain(a, input, output)
-                    .total_cmp(&self.gain(b, input, output))
-            })?;
-        (self.gain(best, input, output) > 0.0).then(|| &self.modes[best])
+        let mut best: Option<(usize, f64)> = None;
+        let mut k = 0;
+        while k < self.modes.len() {
+            let f = self.modes[k].frequency_hz;
+            let mut end = k + 1;
+            while end < self.modes.len()
+                && (self.modes[end].frequency_hz - f).abs() <= 1e-9 * f.abs().max(1e-9)
+            {
+                end += 1;
+            }
+            let total: f64 = (k..end).map(|j| self.gain(j, input, output)).sum();
+            if f >= min_hz && total.is_finite() && best.is_none_or(|(_, g)| total > g) {
+                best = Some((k, total));
+            }
+            k = end;
+        }
+        best.filter(|&(_, g)| g > 0.0).map(|(k, _)| &self.modes[k])
     }
 }
 
