@@ -5,10 +5,11 @@
 //!
 //! A Krylov method started from one vector sees one copy of a repeated eigenvalue in exact
 //! arithmetic (square plates have paired modes, f(k₁, k₂) = f(k₂, k₁)), and in floating point
-//! may also return spurious copies of a converged one. So the solver runs again from new start
-//! vectors, each finding another vector of every repeated eigenspace, and merges the runs by
-//! Rayleigh–Ritz on the union of their vectors, keeping the pairs whose residual has
-//! converged; it stops when a run changes none of the wanted eigenvalues.
+//! may also return spurious copies of a converged one. So the solver runs twice, in parallel,
+//! from different start vectors, each finding its own vector of every repeated eigenspace, and
+//! merges the runs by Rayleigh–Ritz on the union of their vectors, keeping the pairs whose
+//! residual has converged. Two runs find both copies of the pairs of square plates; three-fold
+//! or higher multiplicities would need more.
 
 use super::system::SymSparse;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -21,8 +22,8 @@ use faer::reborrow::ReborrowMut;
 use faer::sparse::linalg::solvers::Llt;
 use faer::{Mat, MatMut, MatRef, Par, Side};
 
-/// Runs from new start vectors after the first: one finds the second copy of every pair.
-const MAX_RESTARTS: usize = 1;
+/// Lanczos runs from different start vectors: two find both copies of every pair.
+const RUNS: usize = 2;
 /// The Krylov solver's convergence tolerance.
 const LANCZOS_TOLERANCE: f64 = f64::EPSILON * 128.0;
 /// Extra eigenpairs asked of each run, so that the last wanted ones converge.
@@ -161,31 +162,23 @@ pub(super) fn lowest_eigenpairs(s: &SymSparse, want: usize) -> Option<(Vec<f64>,
     let shifted = SymSparse::combine(1.0, s, 0.0, s, &vec![-sigma; n]);
     let llt = shifted.lower()?.sp_cholesky(Side::Lower).ok()?;
     let ask = (want + GUARD).min(n);
-    // Converged vectors so far: orthonormal columns, Ritz vectors of S, ascending λ.
-    let mut basis: Vec<Vec<f64>> = Vec::new();
-    let mut lambdas: Vec<f64> = Vec::new();
     let tolerance = 1e-9 * max_diag.max(f64::MIN_POSITIVE);
-    for round in 0..=MAX_RESTARTS {
-        let op = ShiftInvert { llt: &llt, n };
-        let new = run(&op, ask, 0.7548776662466927 * (round + 1) as f64);
-        let before = lambdas.clone();
-        let mut candidates = basis.clone();
-        candidates.extend(new.into_iter().map(|(_, v)| v));
-        (basis, lambdas) = rayleigh_ritz(s, orthonormalise(candidates), tolerance);
-        basis.truncate(ask);
-        lambdas.truncate(ask);
-        // Done when a run from a new start changes none of the wanted eigenvalues.
-        let settled = round > 0
-            && lambdas.len() >= want.min(before.len())
-            && before
-                .iter()
-                .zip(&lambdas)
-                .take(want)
-                .all(|(a, b)| (a - b).abs() <= 1e-10 * a.abs().max(tolerance));
-        if settled || basis.len() >= n {
-            break;
-        }
-    }
+    // The runs are independent: each on its own thread (the factor is shared read-only).
+    let op = ShiftInvert { llt: &llt, n };
+    let runs: Vec<Vec<(f64, Vec<f64>)>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..RUNS)
+            .map(|k| {
+                let op = &op;
+                scope.spawn(move || run(op, ask, 0.7548776662466927 * (k + 1) as f64))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_default())
+            .collect()
+    });
+    let candidates: Vec<Vec<f64>> = runs.into_iter().flatten().map(|(_, v)| v).collect();
+    let (mut basis, mut lambdas) = rayleigh_ritz(s, orthonormalise(candidates), tolerance);
     basis.truncate(want);
     lambdas.truncate(want);
     let vectors = Mat::<f64>::from_fn(n, basis.len(), |i, j| basis[j][i]);
