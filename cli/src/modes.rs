@@ -56,17 +56,27 @@ fn sig(v: f64) -> String {
     }
 }
 
-/// (channel, channel) pairs of the gain columns: every linear input to every linear output.
+/// (channel, channel) pairs of the gain columns: every input to every output that some
+/// listed mode links (a position input on a contact open at rest links nothing).
 fn gain_columns(a: &ModalAnalysis) -> Vec<(usize, usize)> {
     let mut cols = Vec::new();
-    for i in 0..a.num_inputs {
-        for o in 0..a.num_outputs {
-            if a.input_linear[i] && a.output_linear[o] {
-                cols.push((i + 1, o + 1));
+    for i in 1..=a.num_inputs {
+        for o in 1..=a.num_outputs {
+            if (0..a.modes.len()).any(|k| a.gain(k, i, o) != 0.0) {
+                cols.push((i, o));
             }
         }
     }
     cols
+}
+
+/// The inputs that reach no output through the listed modes, as `in2, in3`.
+fn silent_inputs(a: &ModalAnalysis, cols: &[(usize, usize)]) -> String {
+    (1..=a.num_inputs)
+        .filter(|i| !cols.iter().any(|c| c.0 == *i))
+        .map(|i| format!("in{i}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The modes table (or CSV) of an analysis.
@@ -151,6 +161,10 @@ pub(crate) fn modes(a: &ModesArgs) -> Result<(), Failure> {
         analysis.modes.len()
     );
     print!("{}", format_modes(&analysis, false));
+    let silent = silent_inputs(&analysis, &gain_columns(&analysis));
+    if !silent.is_empty() {
+        println!("no gain at rest from {silent} (open contacts or parameter inputs)");
+    }
     let gersh = engine.gershgorin_stiffness_limit(1.0);
     match engine.stiffness_limit(1.0) {
         StiffnessLimit::Exact(g) => println!(
