@@ -395,3 +395,45 @@ fn exact_limit_is_never_below_the_gershgorin_bound_on_the_presets() {
         assert!(exact >= gersh * (1.0 - 1e-9), "{name}: {exact} < {gersh}");
     }
 }
+
+/// The modal reference pitch against the strongest FFT peak of a rendered impulse response on
+/// the presets small enough to render (the pitch estimate the instrument uses today). Prints
+/// the comparison; run with `--ignored --nocapture`.
+#[test]
+#[ignore = "a report, not a check: hammers make the rendered response nonlinear"]
+fn reference_pitch_against_the_fft_estimate() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".mdl"))
+        .collect();
+    names.sort();
+    for name in names {
+        let mut e = engine(&preset(&name), 44_100.0);
+        let Some(input) = e.info().inputs.iter().position(|u| {
+            u.iter()
+                .any(|u| matches!(u, ressort_engine::InputUse::Force(_)))
+        }) else {
+            continue;
+        };
+        let t = std::time::Instant::now();
+        let modal = e.reference_pitch(input + 1, 1);
+        let took = t.elapsed();
+        let n_in = e.info().num_inputs();
+        let frames = 8192;
+        let mut inputs = vec![vec![0.0; frames]; n_in];
+        inputs[input][0] = -1e-3;
+        let fft = if e.info().num_points < 5000 {
+            let y = &render(&mut e, frames, 256, &inputs)[0];
+            ressort_engine::instrument::prepare::peak_frequency(y, 44_100.0)
+        } else {
+            None
+        };
+        eprintln!(
+            "{name}: in{} modal {modal:?} ({took:.2?}), FFT {fft:?}",
+            input + 1
+        );
+    }
+}
