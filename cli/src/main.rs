@@ -7,11 +7,14 @@
 //! ressort render MODEL.mdl -o OUT.wav --as-plugin [--midi FILE.mid] [--note KEY[:VEL][@S]]…
 //!                [--sidechain FILE.wav] [--main FILE.wav] [--control NAME=VALUE]…
 //! ressort bench MODEL.mdl [--sample-rate HZ] [--seconds S]
+//! ressort modes MODEL.mdl [--count N] [--sample-rate HZ] [--csv]
+//! ressort tune MODEL.mdl --mode K --to FREQ|NOTE [--param NAME] [--sample-rate HZ]
 //! ```
 //!
 //! Exit status: 0 for success, 1 when the model has errors, 2 for usage and I/O errors.
 
 mod midi;
+mod modes;
 mod play;
 mod report;
 
@@ -41,6 +44,11 @@ enum Command {
     Render(Box<RenderArgs>),
     /// Measure a model: parse and compile time, then time per sample with no I/O.
     Bench(BenchArgs),
+    /// List a model's modes: frequency, note, T60 and the gain from each input to each
+    /// output (linearised at rest, spec §5.5).
+    Modes(modes::ModesArgs),
+    /// Find the parameter value (or K-class gain) that puts one mode on a target pitch.
+    Tune(modes::TuneArgs),
 }
 
 #[derive(Args, Debug)]
@@ -152,6 +160,8 @@ fn main() -> ExitCode {
         Command::Check(a) => check(&a),
         Command::Render(a) => render(&a),
         Command::Bench(a) => bench(&a),
+        Command::Modes(a) => modes::modes(&a),
+        Command::Tune(a) => modes::tune(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

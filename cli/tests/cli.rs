@@ -257,3 +257,149 @@ fn bench_ends_with_the_machine_readable_line() {
     assert_eq!(fields[2].1, "1004");
     assert_eq!(fields[3].1, "1003");
 }
+
+const STRING_10: &str = "\
+@K param 0.2
+@s string 12 1. K 0. 0. 0.
+@in1 frcInput [@s 0.3]
+@out1 posOutput [@s 0.7]
+";
+
+/// f_k = SR/π·asin(√(K/M)·sin(kπ/2(N+1))) (spec §5.3).
+fn string_mode(k: f64, n: f64, k_over_m: f64, sr: f64) -> f64 {
+    sr / std::f64::consts::PI
+        * (k_over_m.sqrt() * (k * std::f64::consts::PI / (2.0 * (n + 1.0))).sin()).asin()
+}
+
+#[test]
+fn modes_prints_the_closed_form_frequencies_and_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(dir.path(), "s.mdl", STRING_10);
+    let out = ressort(&["modes", model.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("10 moving masses"), "{stdout}");
+    assert!(stdout.contains("in1→out1"), "{stdout}");
+    assert!(stdout.contains("stiffness gain limit"), "{stdout}");
+    let f1 = format!("{:.4}", string_mode(1.0, 10.0, 0.2, 44_100.0));
+    assert!(stdout.contains(&f1), "{f1} not in\n{stdout}");
+
+    let out = ressort(&["modes", model.to_str().unwrap(), "--csv", "--count", "3"]);
+    assert_eq!(out.status.code(), Some(0));
+    let csv = text(&out.stdout);
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines[0], "mode,frequency_hz,note,cents,t60_s,gain_in1_out1");
+    assert_eq!(lines.len(), 4);
+    let f3: f64 = lines[3].split(',').nth(1).unwrap().parse().unwrap();
+    assert!((f3 - string_mode(3.0, 10.0, 0.2, 44_100.0)).abs() < 1e-4);
+}
+
+#[test]
+fn tune_finds_the_param_value_and_the_gain() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(dir.path(), "s.mdl", STRING_10);
+    let out = ressort(&[
+        "tune",
+        model.to_str().unwrap(),
+        "--mode",
+        "2",
+        "--to",
+        "A4",
+        "--param",
+        "K",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains(":1: @K param 0.2"), "{stdout}");
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("change to: @K param "))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let k: f64 = line.rsplit(' ').next().unwrap().parse().unwrap();
+    // sin²(π·440/SR) = (K/M)·sin²(2π/22): K exactly.
+    let s = (2.0 * std::f64::consts::PI / 22.0).sin();
+    let expect = ((std::f64::consts::PI * 440.0 / 44_100.0).sin() / s).powi(2);
+    assert!((k - expect).abs() < 1e-7 * expect, "{k} vs {expect}");
+    // The tuned model's mode 2 is on A4.
+    let tuned = write(
+        dir.path(),
+        "t.mdl",
+        &STRING_10.replace("0.2", &k.to_string()),
+    );
+    let out = ressort(&["modes", tuned.to_str().unwrap(), "--csv"]);
+    let csv = text(&out.stdout);
+    let f2: f64 = csv
+        .lines()
+        .nth(2)
+        .unwrap()
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((f2 - 440.0).abs() < 1e-5, "{f2}");
+
+    // Without --param: the K-class gain, λ_target/λ.
+    let out = ressort(&[
+        "tune",
+        model.to_str().unwrap(),
+        "--mode",
+        "1",
+        "--to",
+        "100Hz",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let f1 = string_mode(1.0, 10.0, 0.2, 44_100.0);
+    let c = ((std::f64::consts::PI * 100.0 / 44_100.0).sin()
+        / (std::f64::consts::PI * f1 / 44_100.0).sin())
+    .powi(2);
+    let shown: f64 = stdout
+        .split("K-class gain ×")
+        .nth(1)
+        .and_then(|t| t.split(',').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!((shown - c).abs() < 1e-7 * c, "{shown} vs {c}");
+
+    let out = ressort(&["tune", model.to_str().unwrap(), "--mode", "1", "--to", "H9"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+/// The `ressort modes` and `ressort tune` examples of the language guide's "Tuning by maths"
+/// are what the commands print.
+#[test]
+fn tuning_by_maths_examples_are_real() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let guide = std::fs::read_to_string(root.join("docs/LANGUAGE.md")).unwrap();
+    let section = guide
+        .split("## 18. Tuning by maths")
+        .nth(1)
+        .expect("the guide has a Tuning by maths section");
+    let mut checked = 0;
+    let mut parts = section.split("```sh\n").skip(1);
+    for part in parts.by_ref() {
+        let (command, rest) = part.split_once("```\n").unwrap();
+        let shown = rest
+            .trim_start()
+            .strip_prefix("```text\n")
+            .and_then(|t| t.split_once("```\n"))
+            .map(|(t, _)| t)
+            .expect("a text block after the command");
+        let args: Vec<&str> = command.split_whitespace().skip(1).collect();
+        let out = Command::new(env!("CARGO_BIN_EXE_ressort"))
+            .args(&args)
+            .current_dir(&root)
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{command}: {}",
+            text(&out.stderr)
+        );
+        assert_eq!(text(&out.stdout), shown, "{command}");
+        checked += 1;
+    }
+    assert!(checked >= 2);
+}

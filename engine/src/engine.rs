@@ -914,6 +914,22 @@ impl Engine {
         self.motion_counter = 0;
     }
 
+    /// The positions of stage 0 (spec §1.5) with the current parameter values, every point
+    /// then every connection point, without touching the running state: the rest state the
+    /// modal analysis linearises at. Allocates (off the audio thread).
+    pub(crate) fn rest_positions(&mut self) -> Vec<f64> {
+        self.apply_pending_changes();
+        let mut x = vec![0.0; self.points.x.len()];
+        for run in &self.init_runs {
+            let x0 = self.program.eval(run.x0, &self.params, &mut self.stack);
+            x[run.first as usize..(run.first + run.count) as usize].fill(x0);
+        }
+        for i in 0..self.proxies.len() {
+            x[self.proxies.base + i] = self.proxies.interpolate(i, &x);
+        }
+        x
+    }
+
     /// Applies parameter and gain changes now instead of at the next block.
     pub fn apply_pending_changes(&mut self) {
         if self.params_dirty {

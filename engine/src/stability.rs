@@ -26,7 +26,7 @@
 //! K < 4K_s and 4K otherwise.
 
 use crate::engine::Engine;
-use crate::info::PointKind;
+use crate::network::{endpoint_nodes, kind_moves, Network, Valuation};
 use std::fmt;
 
 /// The per-mass rule for one moving point.
@@ -191,196 +191,73 @@ fn analyze(e: &Engine) -> StabilityReport {
     let info = &e.info;
     let n = info.num_points;
     let args = &e.args;
-    let mut k_eq = vec![0.0; n];
-    let mut z_eq = vec![0.0; n];
+    // The network with every nonlinear law at its bounded tangent (crate::network).
+    let net = Network::walk(e, Valuation::Bound);
+    let mut k_eq = net.k_ground.clone();
+    let mut z_eq = net.z_ground.clone();
     let mut k_cp = vec![0.0; n];
     let mut z_cp = vec![0.0; n];
-    let mut warnings = Vec::new();
+    let mut warnings = net.warnings.clone();
 
-    let is_moving = |p: usize| -> bool {
-        match info.points[p].kind {
-            PointKind::Mass | PointKind::Osc | PointKind::MassG => true,
-            PointKind::MacroNode { fixed } => !fixed,
-            PointKind::Ground | PointKind::Avatar => false,
-        }
-    };
+    let is_moving = |p: usize| -> bool { kind_moves(info.points[p].kind) };
     // The share of an endpoint that moves: 1 or 0 for a point, the weights of its moving
     // nodes for a connection point.
     let moving_weight = |p: u32| -> f64 {
-        let p = p as usize;
-        if p < n {
-            is_moving(p) as u32 as f64
-        } else if let Some(i) = p
-            .checked_sub(e.proxies.base)
-            .filter(|&i| i < e.proxies.len())
-        {
-            e.proxies.nodes[i]
-                .iter()
-                .zip(e.proxies.weights[i])
-                .filter(|(node, _)| is_moving(**node as usize))
-                .map(|(_, w)| w)
-                .sum()
-        } else {
-            0.0
-        }
+        endpoint_nodes(e, p)
+            .filter(|&(node, _)| is_moving(node))
+            .map(|(_, w)| w)
+            .sum()
     };
     // Off-diagonal row sums of a link a–b on a's side: towards b, and, for a connection
     // point, among a's own nodes.
     let couple = |a: u32, b: u32, k: f64, z: f64, k_cp: &mut [f64], z_cp: &mut [f64]| {
         let other = moving_weight(b);
-        let p = a as usize;
-        if p < n {
-            k_cp[p] += k * other;
-            z_cp[p] += z * other;
-        } else if let Some(i) = p
-            .checked_sub(e.proxies.base)
-            .filter(|&i| i < e.proxies.len())
-        {
+        if (a as usize) < n {
+            k_cp[a as usize] += k * other;
+            z_cp[a as usize] += z * other;
+        } else {
             let own = moving_weight(a);
-            for (node, w) in e.proxies.nodes[i].iter().zip(e.proxies.weights[i]) {
+            for (node, w) in endpoint_nodes(e, a) {
                 let f = w * (other + own - w).max(0.0);
-                k_cp[*node as usize] += f * k;
-                z_cp[*node as usize] += f * z;
+                k_cp[node] += f * k;
+                z_cp[node] += f * z;
             }
         }
     };
-
     // Adds (k, z) to a point, spreading over macro nodes for connection points.
     let add = |p: u32, k: f64, z: f64, k_eq: &mut [f64], z_eq: &mut [f64]| {
-        let p = p as usize;
-        if p < n {
-            k_eq[p] += k;
-            z_eq[p] += z;
-        } else if let Some(i) = p.checked_sub(e.proxies.base) {
-            if i < e.proxies.len() {
-                for (node, w) in e.proxies.nodes[i].iter().zip(e.proxies.weights[i]) {
-                    k_eq[*node as usize] += w * k;
-                    z_eq[*node as usize] += w * z;
-                }
-            }
+        for (node, w) in endpoint_nodes(e, p) {
+            k_eq[node] += w * k;
+            z_eq[node] += w * z;
         }
     };
+    for l in &net.links {
+        add(l.a, l.k, l.z, &mut k_eq, &mut z_eq);
+        add(l.b, l.k, l.z, &mut k_eq, &mut z_eq);
+        couple(l.a, l.b, l.k, l.z, &mut k_cp, &mut z_cp);
+        couple(l.b, l.a, l.k, l.z, &mut k_cp, &mut z_cp);
+    }
+    let mass = &net.mass;
 
-    // Interaction labels are not kept on the hot structures: warnings name the endpoints.
-    let ix = &e.interactions;
-    let endpoints = |g: &crate::engine::Group, i: usize| -> String {
-        format!(
-            "{}–{}",
-            info.point_label(g.a[i] as usize),
-            info.point_label(g.b[i] as usize)
-        )
-    };
-    let col = |g: &crate::engine::Group, c: usize, i: usize| args[g.cols[c] + i];
-
-    // Linear links, and contacts counted as engaged.
-    for g in [&ix.linear, &ix.contact] {
-        for i in 0..g.len() {
-            let (k, z) = (col(g, 0, i), col(g, 1, i));
-            add(g.a[i], k, z, &mut k_eq, &mut z_eq);
-            add(g.b[i], k, z, &mut k_eq, &mut z_eq);
-            couple(g.a[i], g.b[i], k, z, &mut k_cp, &mut z_cp);
-            couple(g.b[i], g.a[i], k, z, &mut k_cp, &mut z_cp);
-        }
-    }
-    let g = &ix.nl_contact;
-    for i in 0..g.len() {
-        let (s, c, k, z) = (col(g, 0, i), col(g, 1, i), col(g, 2, i), col(g, 3, i));
-        if c < 0.0 {
-            warnings.push(StabilityWarning::NegativeCubic {
-                label: endpoints(g, i),
-                keyword: "nlContact",
-            });
-        }
-        let (k, c) = if k < s { (s, 0.0) } else { (k, c) };
-        let kb = if c == 0.0 {
-            s
-        } else if s >= k || c < 0.0 {
-            k
-        } else {
-            3.0 * k - 2.0 * s
-        };
-        add(g.a[i], kb, z, &mut k_eq, &mut z_eq);
-        add(g.b[i], kb, z, &mut k_eq, &mut z_eq);
-        couple(g.a[i], g.b[i], kb, z, &mut k_cp, &mut z_cp);
-        couple(g.b[i], g.a[i], kb, z, &mut k_cp, &mut z_cp);
-    }
-    for (g, keyword) in [(&ix.nl_spring2, "nlSpring2"), (&ix.nl_spring3, "nlSpring3")] {
-        for i in 0..g.len() {
-            let (k, q, z) = (col(g, 0, i), col(g, 1, i), col(g, 2, i));
-            if q != 0.0 {
-                warnings.push(StabilityWarning::Unbounded {
-                    label: endpoints(g, i),
-                    keyword,
-                });
-            }
-            add(g.a[i], k, z, &mut k_eq, &mut z_eq);
-            add(g.b[i], k, z, &mut k_eq, &mut z_eq);
-            couple(g.a[i], g.b[i], k, z, &mut k_cp, &mut z_cp);
-            couple(g.b[i], g.a[i], k, z, &mut k_cp, &mut z_cp);
-        }
-    }
-    let g = &ix.nl_spring_damper;
-    for i in 0..g.len() {
-        let (s, c, k, z) = (col(g, 0, i), col(g, 1, i), col(g, 2, i), col(g, 3, i));
-        if c < 0.0 {
-            warnings.push(StabilityWarning::NegativeCubic {
-                label: endpoints(g, i),
-                keyword: "nlSpringDamper",
-            });
-        } else if c != 0.0 && k < s {
-            warnings.push(StabilityWarning::WeakBound {
-                label: endpoints(g, i),
-            });
-        }
-        let (kb, zb) = if c == 0.0 {
-            (s, z)
-        } else if s >= k || c < 0.0 {
-            (k, z + 0.3 * k)
-        } else {
-            (3.0 * k - 2.0 * s, z + 0.3 * k)
-        };
-        add(g.a[i], kb, zb, &mut k_eq, &mut z_eq);
-        add(g.b[i], kb, zb, &mut k_eq, &mut z_eq);
-        couple(g.a[i], g.b[i], kb, zb, &mut k_cp, &mut z_cp);
-        couple(g.b[i], g.a[i], kb, zb, &mut k_cp, &mut z_cp);
-    }
-    let g = &ix.pluck;
-    for i in 0..g.len() {
-        let (k, z) = (0.9 * col(g, 0, i).abs(), col(g, 2, i));
-        add(g.a[i], k, z, &mut k_eq, &mut z_eq);
-        add(g.b[i], k, z, &mut k_eq, &mut z_eq);
-        couple(g.a[i], g.b[i], k, z, &mut k_cp, &mut z_cp);
-        couple(g.b[i], g.a[i], k, z, &mut k_cp, &mut z_cp);
-    }
-    let g = &ix.bow;
-    for i in 0..g.len() {
-        let (z, smooth) = (col(g, 0, i), col(g, 2, i));
-        let stick = if smooth >= 1.0 {
-            0.63 * 0.5f64.exp() * z
-        } else {
-            2.0 / 3.0 * z
-        };
-        add(g.a[i], 0.0, stick, &mut k_eq, &mut z_eq);
-        add(g.b[i], 0.0, stick, &mut k_eq, &mut z_eq);
-        couple(g.a[i], g.b[i], 0.0, stick, &mut k_cp, &mut z_cp);
-        couple(g.b[i], g.a[i], 0.0, stick, &mut k_cp, &mut z_cp);
-    }
-
-    // Single masses: osc terms.
-    let s = &e.singles;
-    let mut mass = vec![f64::INFINITY; n];
-    for i in 0..s.len() {
-        if s.fixed[i] {
-            continue;
-        }
-        mass[i] = args[s.cols[0] + i];
-        k_eq[i] += args[s.cols[1] + i];
-        z_eq[i] += args[s.cols[2] + i];
-    }
-
-    // Macros: internal links, ground friction, structure limits.
+    // Structure limits of uniform macros (derived, spec §5.2); their links and Z_o are in
+    // the network.
     let m = &e.macros;
-    for mac in m.lines.iter().chain(&m.stiff) {
+    let mut structure = |base: usize, load: f64| {
+        if !(load < 1.0) {
+            let owner = &info.owners[info.points[base].owner as usize];
+            warnings.push(StabilityWarning::StructureLimit {
+                label: owner.label.clone(),
+                keyword: owner.keyword,
+                load,
+            });
+        }
+    };
+    for (mac, stiff) in m
+        .lines
+        .iter()
+        .map(|l| (l, false))
+        .chain(m.stiff.iter().map(|l| (l, true)))
+    {
         let (mm, k, k2, z, zo) = (
             args[mac.slots.m],
             args[mac.slots.k],
@@ -388,46 +265,12 @@ fn analyze(e: &Engine) -> StabilityReport {
             args[mac.slots.z],
             args[mac.slots.zo],
         );
-        let stiff = m.stiff.iter().any(|s| s.base == mac.base);
-        let nn = mac.len;
-        for j in 0..nn {
-            let p = mac.base + j;
-            mass[p] = mm;
-            let links = (j > 0) as u32 + (j + 1 < nn) as u32;
-            k_eq[p] += links as f64 * k;
-            z_eq[p] += links as f64 * z + zo;
-            let moving = (j > 0 && is_moving(p - 1)) as u32 as f64
-                + (j + 1 < nn && is_moving(p + 1)) as u32 as f64;
-            k_cp[p] += moving * k;
-            z_cp[p] += moving * z;
-        }
-        if stiff {
-            let last = nn as isize - 1;
-            for i in -1..=last {
-                let (a, b) = (i.clamp(0, last) as usize, (i + 2).clamp(0, last) as usize);
-                if a != b {
-                    let (pa, pb) = (mac.base + a, mac.base + b);
-                    k_eq[pa] += k2;
-                    k_eq[pb] += k2;
-                    k_cp[pa] += k2 * is_moving(pb) as u32 as f64;
-                    k_cp[pb] += k2 * is_moving(pa) as u32 as f64;
-                }
-            }
-        }
         let lambda_k = if stiff {
             stiff_string_lambda(k, k2)
         } else {
             4.0 * k
         };
-        let load = (lambda_k + 2.0 * (4.0 * z + zo)) / (4.0 * mm);
-        if !(load < 1.0) {
-            let owner = &info.owners[info.points[mac.base].owner as usize];
-            warnings.push(StabilityWarning::StructureLimit {
-                label: owner.label.clone(),
-                keyword: owner.keyword,
-                load,
-            });
-        }
+        structure(mac.base, (lambda_k + 2.0 * (4.0 * z + zo)) / (4.0 * mm));
     }
     for mac in &m.meshes {
         let (mm, k, z, zo) = (
@@ -436,38 +279,7 @@ fn analyze(e: &Engine) -> StabilityReport {
             args[mac.slots.z],
             args[mac.slots.zo],
         );
-        let (l, w) = (mac.length, mac.width);
-        for i in 0..l {
-            for j in 0..w {
-                let p = mac.base + i * w + j;
-                mass[p] = mm;
-                let links =
-                    (i > 0) as u32 + (i + 1 < l) as u32 + (j > 0) as u32 + (j + 1 < w) as u32;
-                k_eq[p] += links as f64 * k;
-                z_eq[p] += links as f64 * z + zo;
-                let moving = [
-                    (i > 0).then(|| p - w),
-                    (i + 1 < l).then(|| p + w),
-                    (j > 0).then(|| p - 1),
-                    (j + 1 < w).then(|| p + 1),
-                ]
-                .into_iter()
-                .flatten()
-                .filter(|&q| is_moving(q))
-                .count() as f64;
-                k_cp[p] += moving * k;
-                z_cp[p] += moving * z;
-            }
-        }
-        let load = (8.0 * k + 2.0 * (8.0 * z + zo)) / (4.0 * mm);
-        if !(load < 1.0) {
-            let owner = &info.owners[info.points[mac.base].owner as usize];
-            warnings.push(StabilityWarning::StructureLimit {
-                label: owner.label.clone(),
-                keyword: owner.keyword,
-                load,
-            });
-        }
+        structure(mac.base, (8.0 * k + 2.0 * (8.0 * z + zo)) / (4.0 * mm));
     }
 
     let mut masses = Vec::new();

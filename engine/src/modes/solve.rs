@@ -1,0 +1,287 @@
+//! From the linear system to the modes (spec §5.5): the symmetric eigenproblem of
+//! S = M^−½·K·M^−½, the per-mode recurrence for proportional damping, the companion matrix
+//! otherwise, and the residues of every (input, output) pair.
+
+use super::sparse::lowest_eigenpairs;
+use super::system::{Port, System};
+use super::{ModalAnalysis, Mode, Solver, COMPANION_LIMIT, DEFAULT_SPARSE_COUNT, DENSE_LIMIT};
+use faer::linalg::solvers::Solve;
+use faer::{c64, Mat, Side};
+
+/// Damping counts as proportional when the off-diagonal part of ψᵀΓψ is below this fraction
+/// of its largest entry.
+const PROPORTIONAL_TOLERANCE: f64 = 1e-9;
+
+pub(super) fn modes(
+    sys: &System,
+    num_points: usize,
+    sample_rate: f64,
+    count: Option<usize>,
+) -> ModalAnalysis {
+    let n = sys.len();
+    let inv_sqrt_m: Vec<f64> = sys.mass.iter().map(|m| 1.0 / m.sqrt()).collect();
+    let s = sys.k.scaled(&inv_sqrt_m);
+    let gamma = sys.z.scaled(&inv_sqrt_m);
+    let mut analysis = ModalAnalysis {
+        sample_rate_hz: sample_rate,
+        modes: Vec::new(),
+        num_inputs: sys.inputs.len(),
+        num_outputs: sys.outputs.len(),
+        input_linear: sys.inputs.iter().map(|p| p.linear).collect(),
+        output_linear: sys.outputs.iter().map(|p| p.linear).collect(),
+        solver: Solver::Dense,
+        proportional: true,
+        degrees_of_freedom: n,
+    };
+    if n == 0 || !s.is_finite() || !gamma.is_finite() || sys.mass.iter().any(|m| !(*m > 0.0)) {
+        return analysis;
+    }
+    let (lambdas, psi) = if n <= DENSE_LIMIT {
+        let Ok(evd) = s.dense().self_adjoint_eigen(Side::Lower) else {
+            return analysis;
+        };
+        let l: Vec<f64> = (0..n).map(|i| evd.S().column_vector()[i]).collect();
+        (l, evd.U().to_owned())
+    } else {
+        analysis.solver = Solver::Sparse;
+        let want = count.unwrap_or(DEFAULT_SPARSE_COUNT).min(n);
+        match lowest_eigenpairs(&s, want) {
+            Some(pair) => pair,
+            None => return analysis,
+        }
+    };
+    let m = lambdas.len();
+    // γ_k = ψ_kᵀΓψ_k, and whether Γ is diagonal in the basis ψ (spec §5.5 step 4).
+    let mut gammas = vec![0.0; m];
+    let mut off = 0.0f64;
+    let mut scale = 0.0f64;
+    let mut col = vec![0.0; n];
+    let mut g_psi = vec![0.0; n];
+    let mut projected = Mat::<f64>::zeros(n, m);
+    for k in 0..m {
+        for i in 0..n {
+            col[i] = psi[(i, k)];
+        }
+        gamma.mul(&col, &mut g_psi);
+        for i in 0..n {
+            projected[(i, k)] = g_psi[i];
+        }
+        gammas[k] = col.iter().zip(&g_psi).map(|(a, b)| a * b).sum();
+        scale = scale.max(gammas[k].abs());
+    }
+    if analysis.solver == Solver::Dense {
+        let g = psi.transpose() * &projected;
+        for j in 0..m {
+            for i in 0..m {
+                if i != j {
+                    off = off.max(g[(i, j)].abs());
+                }
+            }
+        }
+    } else {
+        // Residual ‖Γψ − γψ‖ of each computed mode.
+        for k in 0..m {
+            let r: f64 = (0..n)
+                .map(|i| (projected[(i, k)] - gammas[k] * psi[(i, k)]).powi(2))
+                .sum();
+            off = off.max(r.sqrt());
+        }
+    }
+    analysis.proportional = off <= PROPORTIONAL_TOLERANCE * scale.max(f64::MIN_POSITIVE);
+    if !analysis.proportional && n <= COMPANION_LIMIT {
+        if let Some(modes) = companion_modes(sys, num_points, sample_rate) {
+            analysis.solver = Solver::Companion;
+            analysis.proportional = true;
+            analysis.modes = modes;
+            finish(&mut analysis, count);
+            return analysis;
+        }
+    }
+    for k in 0..m {
+        let phi: Vec<f64> = (0..n).map(|i| psi[(i, k)] * inv_sqrt_m[i]).collect();
+        analysis.modes.push(proportional_mode(
+            sys,
+            num_points,
+            sample_rate,
+            lambdas[k],
+            gammas[k],
+            &phi,
+        ));
+    }
+    finish(&mut analysis, count);
+    analysis
+}
+
+/// Sorts by frequency and keeps the lowest `count`.
+fn finish(analysis: &mut ModalAnalysis, count: Option<usize>) {
+    analysis
+        .modes
+        .sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    if let Some(c) = count {
+        analysis.modes.truncate(c);
+    }
+}
+
+/// f = SR·arg(r)/2π and T60 = −3·ln 10 / (SR·ln|r|) (infinite when |r| ≥ 1).
+fn frequency_and_t60(r: c64, radius: f64, sample_rate: f64) -> (f64, f64) {
+    let f = sample_rate * r.im.atan2(r.re).abs() / (2.0 * std::f64::consts::PI);
+    let t60 = if radius < 1.0 {
+        -3.0 * std::f64::consts::LN_10 / (sample_rate * radius.ln())
+    } else {
+        f64::INFINITY
+    };
+    (f, t60)
+}
+
+/// The value of a port at eigenvalue r along a real shape φ: (p + q·(1 − 1/r))·φ.
+fn port_at(port: &Port, phi: &[f64], r: c64) -> c64 {
+    let p: f64 = port.p.iter().zip(phi).map(|(a, b)| a * b).sum();
+    let q: f64 = port.q.iter().zip(phi).map(|(a, b)| a * b).sum();
+    c64::new(p, 0.0) + c64::new(q, 0.0) * (c64::new(1.0, 0.0) - r.inv())
+}
+
+/// A shape over the material points, largest component ±1.
+fn shape_over_points(sys: &System, num_points: usize, x: impl Fn(usize) -> f64) -> Vec<f64> {
+    let mut shape = vec![0.0; num_points];
+    let mut big = 0.0f64;
+    for (i, &p) in sys.point.iter().enumerate() {
+        shape[p as usize] = x(i);
+        big = big.max(x(i).abs());
+    }
+    if big > 0.0 {
+        for v in &mut shape {
+            *v /= big;
+        }
+    }
+    shape
+}
+
+/// One mode of the recurrence q[n+1] = (2 − λ − γ)·q[n] + (γ − 1)·q[n−1] + φᵀf[n] (spec §5.1
+/// with K/M → λ, Z/M → γ): roots of z² − (2 − λ − γ)·z + (1 − γ) = 0; with q[1] = φᵀb the
+/// response is φᵀb·(rⁿ − r₂ⁿ)/(r − r₂), so the residue of r is α·β/(r − r₂).
+fn proportional_mode(
+    sys: &System,
+    num_points: usize,
+    sample_rate: f64,
+    lambda: f64,
+    gamma: f64,
+    phi: &[f64],
+) -> Mode {
+    let a = 2.0 - lambda - gamma;
+    let b = 1.0 - gamma;
+    let disc = a * a - 4.0 * b;
+    // |r|² = r·r̄ = 1 − γ exactly for a complex pair: an undamped mode keeps |r| = 1.
+    let (r, r2, complex) = if disc < 0.0 {
+        let r = c64::new(a / 2.0, (-disc).sqrt() / 2.0);
+        (r, r.conj(), true)
+    } else {
+        let (r1, r2) = ((a + disc.sqrt()) / 2.0, (a - disc.sqrt()) / 2.0);
+        let (big, small) = if r1.abs() >= r2.abs() {
+            (r1, r2)
+        } else {
+            (r2, r1)
+        };
+        (c64::new(big, 0.0), c64::new(small, 0.0), false)
+    };
+    let radius = if complex { b.max(0.0).sqrt() } else { r.norm() };
+    let (frequency_hz, t60_s) = frequency_and_t60(r, radius, sample_rate);
+    let denom = r - r2;
+    let mut gains = Vec::with_capacity(sys.inputs.len() * sys.outputs.len());
+    for input in &sys.inputs {
+        let beta = port_at(input, phi, r);
+        for output in &sys.outputs {
+            let alpha = port_at(output, phi, r);
+            let g = if denom.norm() > 1e-300 {
+                (alpha * beta / denom).norm() * if complex { 2.0 } else { 1.0 }
+            } else {
+                // A double root (a free body, r = 1): the response grows linearly.
+                (alpha * beta).norm()
+            };
+            gains.push(g);
+        }
+    }
+    Mode {
+        frequency_hz,
+        t60_s,
+        radius,
+        lambda,
+        gains,
+        shape: shape_over_points(sys, num_points, |i| phi[i]),
+    }
+}
+
+/// The eigenvalues of the 2N companion matrix, with residues (C·v)(w·B)/r from the right
+/// eigenvectors v and the rows w of V⁻¹. Complex eigenvalues with Im r > 0 are listed once per
+/// conjugate pair; real (non-oscillating) roots are not listed.
+fn companion_modes(sys: &System, num_points: usize, sample_rate: f64) -> Option<Vec<Mode>> {
+    let n = sys.len();
+    let k = sys.k.dense();
+    let z = sys.z.dense();
+    let mut a = Mat::<f64>::zeros(2 * n, 2 * n);
+    for i in 0..n {
+        let inv_m = 1.0 / sys.mass[i];
+        for j in 0..n {
+            a[(i, j)] = -(k[(i, j)] + z[(i, j)]) * inv_m;
+            a[(i, n + j)] = z[(i, j)] * inv_m;
+        }
+        a[(i, i)] += 2.0;
+        a[(i, n + i)] -= 1.0;
+        a[(n + i, i)] = 1.0;
+    }
+    let evd = a.eigen().ok()?;
+    let v = evd.U();
+    let lu = v.partial_piv_lu();
+    // Right-hand sides: [M⁻¹p; 0] and [M⁻¹q; 0] of every input.
+    let ni = sys.inputs.len();
+    let mut rhs = Mat::<c64>::zeros(2 * n, 2 * ni);
+    for (c, input) in sys.inputs.iter().enumerate() {
+        for i in 0..n {
+            rhs[(i, 2 * c)] = c64::new(input.p[i] / sys.mass[i], 0.0);
+            rhs[(i, 2 * c + 1)] = c64::new(input.q[i] / sys.mass[i], 0.0);
+        }
+    }
+    let wb = lu.solve(&rhs);
+    let one = c64::new(1.0, 0.0);
+    let mut modes = Vec::new();
+    for m in 0..2 * n {
+        let r = evd.S().column_vector()[m];
+        if !(r.im > 1e-12 * r.norm().max(1e-300)) {
+            continue;
+        }
+        let (frequency_hz, t60_s) = frequency_and_t60(r, r.norm(), sample_rate);
+        let vel = one - r.inv();
+        let mut gains = Vec::with_capacity(ni * sys.outputs.len());
+        for c in 0..ni {
+            let beta = wb[(m, 2 * c)] + wb[(m, 2 * c + 1)] * vel;
+            for output in &sys.outputs {
+                // y = p·x[n] + q·(x[n] − x[n−1]) on v = (x[n], x[n−1]).
+                let mut alpha = c64::new(0.0, 0.0);
+                for i in 0..n {
+                    alpha += v[(i, m)] * (output.p[i] + output.q[i]) - v[(n + i, m)] * output.q[i];
+                }
+                gains.push(2.0 * (alpha * beta / r).norm());
+            }
+        }
+        // The real part of the shape after rotating its largest component onto the real axis.
+        let big = (0..n)
+            .max_by(|&i, &j| v[(i, m)].norm().total_cmp(&v[(j, m)].norm()))
+            .map(|i| v[(i, m)])
+            .unwrap_or(one);
+        let rot = if big.norm() > 0.0 {
+            big.conj() / big.norm()
+        } else {
+            one
+        };
+        let radius = r.norm();
+        let gamma = 1.0 - radius * radius;
+        modes.push(Mode {
+            frequency_hz,
+            t60_s,
+            radius,
+            lambda: 2.0 - gamma - 2.0 * r.re,
+            gains,
+            shape: shape_over_points(sys, num_points, |i| (v[(i, m)] * rot).re),
+        });
+    }
+    Some(modes)
+}
