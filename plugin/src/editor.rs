@@ -809,6 +809,18 @@ impl EditorApp {
                 ui.add(ParamSlider::for_param(&p.macros[*i].value, &setter));
                 self.cc_learn(ui, *i, learning);
             });
+            // The value the model sees, per step, under the slot's musical unit.
+            let used = rt.macros[*i].load(Ordering::Relaxed);
+            ui.label(
+                RichText::new(format!(
+                    "{} = {} per step",
+                    b.name,
+                    crate::model::format_value(b.value_at(used))
+                ))
+                .small()
+                .color(Color32::GRAY),
+            )
+            .on_hover_text("The parameter's value in the script's units (per step)");
             if let Some(cc) = ccs.cc_of(*i) {
                 let host = p.macros[*i].value.value() as f64;
                 let used = rt.macros[*i].load(Ordering::Relaxed);

@@ -14,6 +14,7 @@ use crate::runtime::RuntimeStatus;
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::params::persist::PersistentField;
 use ressort_engine::instrument;
+use ressort_engine::instrument::units::MacroUnit;
 pub use ressort_engine::instrument::{
     parse_script, peak_frequency, HostSettings, InputRole, LoadLine, MacroBinding, Prepared,
     Rejected, StabilityEnvelope, CHUNK, NUM_MACROS, STABILITY_HEADROOM,
@@ -64,6 +65,8 @@ pub struct ModelSummary {
     pub outputs: Vec<String>,
     pub params: Vec<String>,
     pub macros: Vec<Option<MacroBinding>>,
+    /// How each slot reads (Hz, T60, ratio, 0 … 1 or its value).
+    pub macro_units: Vec<MacroUnit>,
     pub stability: Vec<String>,
     pub reference_pitch_hz: Option<f64>,
     pub reference_key: f64,
@@ -135,6 +138,7 @@ pub fn summary(prepared: &mut Prepared) -> ModelSummary {
         outputs,
         params,
         macros: prepared.macros.clone(),
+        macro_units: prepared.macro_units.clone(),
         stability,
         reference_pitch_hz: prepared.settings.reference_pitch_hz,
         reference_key: prepared.settings.reference_key,
@@ -233,8 +237,10 @@ impl ModelStore {
     /// `unbound` when the model has fewer parameters.
     pub fn macro_text(&self, slot: usize, normalized: f64) -> String {
         let status = lock(&self.status);
-        match status.summary.macros.get(slot) {
-            Some(Some(b)) => format!("{} = {}", b.name, format_value(b.value_at(normalized))),
+        let s = &status.summary;
+        match (s.macros.get(slot), s.macro_units.get(slot)) {
+            (Some(Some(b)), Some(u)) => u.text(b, normalized),
+            (Some(Some(b)), None) => MacroUnit::Value.text(b, normalized),
             _ => param_text::format_unbound_macro(normalized),
         }
     }
@@ -243,10 +249,10 @@ impl ModelStore {
     /// `K = 0.12` or `0.12` for a slot bound to `K`, `50 %` for an unbound one.
     pub fn macro_from_text(&self, slot: usize, text: &str) -> Option<f64> {
         let status = lock(&self.status);
-        match status.summary.macros.get(slot) {
-            Some(Some(b)) => {
-                param_text::parse_bound_macro(text, &b.name).map(|v| b.normalized_of(v))
-            }
+        let s = &status.summary;
+        match (s.macros.get(slot), s.macro_units.get(slot)) {
+            (Some(Some(b)), Some(u)) => u.position_of(b, text),
+            (Some(Some(b)), None) => MacroUnit::Value.position_of(b, text),
             _ => param_text::parse_unbound_macro(text),
         }
     }

@@ -38,31 +38,58 @@ fn every_preset_prepares_at_every_common_rate() {
     }
 }
 
-/// The clamp's limit is where the coupled (Gershgorin) load of the worst mass reaches the
-/// headroom; a uniform string and mesh reach exactly their structure limits there.
+/// The clamp's limit: the exact stability limit of the linear network (issue 14) with the
+/// headroom, where it applies — never below the coupled (Gershgorin) bound it replaces, and
+/// stable there by the exact criterion; elsewhere the Gershgorin bound, where the worst mass
+/// reaches the headroom.
 #[test]
 fn the_stiffness_limit_matches_the_stability_analysis() {
     for preset in PRESETS {
         let mut p = prepare(preset.id, preset.text, 48_000.0).unwrap();
         let limit = p.envelope.max_stiffness(1.0);
         assert!(limit.is_finite() && limit > 0.0, "{}: {limit}", preset.id);
-        p.engine.set_class_gain(ScaleClass::Stiffness, limit);
-        let at = p.engine.stability();
-        let worst = at
-            .masses
-            .iter()
-            .map(|m| m.coupled_load())
-            .fold(0.0, f64::max);
-        // At the limit the worst mass is at the headroom, or, for a model whose bound already
-        // rejects unit gains (scaled envelope), at most its own bound at unit gains.
-        assert!(
-            (worst - STABILITY_HEADROOM).abs() < 1e-9
-                || (limit <= 1.0 + 1e-9 && worst <= p.worst_load.0 + 1e-9),
-            "{} at ×{limit}: worst coupled load {worst}",
-            preset.id
-        );
-        assert!(at.is_stable(), "{} at its limit ×{limit}", preset.id);
-        println!("{:<22} stiffness limit ×{limit:9.3}", preset.id);
+        let gershgorin = ressort_engine::instrument::envelope::envelope(&mut p.engine);
+        let bound = gershgorin.max_stiffness(1.0);
+        let exact = p.engine.exact_stability();
+        match exact.max_stiffness(1.0) {
+            Some(e) if exact.is_stable(1.0, 1.0) == Some(true) => {
+                assert!(
+                    limit <= STABILITY_HEADROOM * e * (1.0 + 1e-9),
+                    "{}: clamp ×{limit} beyond the headroom of the exact limit ×{e}",
+                    preset.id
+                );
+                assert!(
+                    limit >= bound * (1.0 - 1e-9),
+                    "{}: ×{limit} < bound ×{bound}",
+                    preset.id
+                );
+                assert_eq!(exact.is_stable(limit, 1.0), Some(true), "{}", preset.id);
+                println!(
+                    "{:<22} stiffness limit ×{limit:9.3} (exact ×{e:9.3}, Gershgorin ×{bound:9.3})",
+                    preset.id
+                );
+            }
+            _ => {
+                p.engine.set_class_gain(ScaleClass::Stiffness, limit);
+                let at = p.engine.stability();
+                let worst = at
+                    .masses
+                    .iter()
+                    .map(|m| m.coupled_load())
+                    .fold(0.0, f64::max);
+                assert!(
+                    (worst - STABILITY_HEADROOM).abs() < 1e-9
+                        || (limit <= 1.0 + 1e-9 && worst <= p.worst_load.0 + 1e-9),
+                    "{} at ×{limit}: worst coupled load {worst}",
+                    preset.id
+                );
+                assert!(at.is_stable(), "{} at its limit ×{limit}", preset.id);
+                println!(
+                    "{:<22} stiffness limit ×{limit:9.3} (Gershgorin)",
+                    preset.id
+                );
+            }
+        }
     }
 }
 

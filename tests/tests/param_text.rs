@@ -106,14 +106,41 @@ fn texts_put_the_number_first_and_read_what_people_type() {
     assert_eq!(plugin.param_value_of_text(guard, "Tripped"), Some(1.0));
     assert_eq!(plugin.param_value_of_text(guard, "Clear"), Some(0.0));
 
+    // Macro slots read in musical units: the membrane's K as the frequency of its reference
+    // mode, its Z as that mode's T60. The per-step value is still understood.
     let macro1 = id(&mut plugin, "Macro 1");
-    assert_eq!(
-        plugin.param_text(macro1, 0.5).as_deref(),
-        Some("K = 0.0800")
+    let k_text = plugin.param_text(macro1, 0.5).unwrap();
+    let low = plugin.param_text(macro1, 0.0).unwrap();
+    let high = plugin.param_text(macro1, 1.0).unwrap();
+    println!("Macro 1: {low} … {k_text} … {high}");
+    let hz = |t: &str| -> f64 {
+        let r = t.strip_prefix("K: ");
+        r.and_then(|r| r.strip_suffix(" kHz"))
+            .and_then(|v| v.parse::<f64>().ok())
+            .map(|k| k * 1000.0)
+            .or_else(|| {
+                r.and_then(|r| r.strip_suffix(" Hz"))
+                    .and_then(|v| v.parse().ok())
+            })
+            .unwrap_or_else(|| panic!("`{t}` is not `K: … Hz`"))
+    };
+    assert!(
+        hz(&low) < hz(&k_text) && hz(&k_text) < hz(&high),
+        "stiffer is higher"
     );
+    let back = plugin.param_value_of_text(macro1, &k_text).unwrap();
+    assert!((back - 0.5).abs() < 1e-4, "`{k_text}` reads {back}");
     assert_eq!(plugin.param_value_of_text(macro1, "K = 0.0800"), Some(0.5));
     assert_eq!(plugin.param_value_of_text(macro1, "0.08"), Some(0.5));
     assert_eq!(plugin.param_value_of_text(macro1, "Z = 0.08"), None);
+    let macro2 = id(&mut plugin, "Macro 2");
+    let z_text = plugin.param_text(macro2, 0.5).unwrap();
+    let z_more = plugin.param_text(macro2, 1.0).unwrap();
+    println!("Macro 2: {z_text} … {z_more}");
+    assert!(
+        z_text.starts_with("Z: T60 ") && z_text.ends_with(" s"),
+        "{z_text}"
+    );
     let macro3 = id(&mut plugin, "Macro 3");
     assert_eq!(
         plugin.param_text(macro3, 0.25).as_deref(),

@@ -155,6 +155,57 @@ pub fn envelope(engine: &mut Engine) -> StabilityEnvelope {
     raw.scaled(scale)
 }
 
+/// Damping gains, as fractions of the largest stable one, at which the exact envelope takes a
+/// point of the stability boundary.
+const EXACT_SAMPLES: [f64; 2] = [0.0, 0.5];
+
+/// The exact stability limit of the linear network (4M − K − 2Z positive definite, see
+/// [`crate::modes`]) as an envelope: lines through points of its boundary in the (Stiffness,
+/// Damping) gain plane, at Damping gains 0 and ½ of the largest stable one and on the Damping
+/// axis. The stable region is convex (the criterion is linear in the gains), so these
+/// chords lie inside it and the clamp stays safe. None where the criterion does not apply (a
+/// negative stiffness or damping in the network) or rejects the model as written: the
+/// Gershgorin envelope remains there.
+pub fn exact_envelope(engine: &mut Engine) -> Option<StabilityEnvelope> {
+    let ex = engine.exact_stability();
+    if ex.is_stable(1.0, 1.0) != Some(true) {
+        return None;
+    }
+    let z_max = ex.max_damping(0.0)?;
+    let k_max = ex.max_stiffness(0.0)?;
+    let mut lines = Vec::new();
+    if !z_max.is_finite() {
+        // Nothing scales with Damping: the Stiffness limit alone.
+        lines.push(LoadLine {
+            k: 1.0 / k_max,
+            z: 0.0,
+        });
+    } else if !k_max.is_finite() {
+        lines.push(LoadLine {
+            k: 0.0,
+            z: 1.0 / z_max,
+        });
+    } else {
+        let mut points: Vec<(f64, f64)> = Vec::with_capacity(EXACT_SAMPLES.len() + 1);
+        for f in EXACT_SAMPLES {
+            let z = f * z_max;
+            points.push((ex.max_stiffness(z)?, z));
+        }
+        points.push((0.0, z_max));
+        for w in points.windows(2) {
+            let ((k1, z1), (k2, z2)) = (w[0], w[1]);
+            let det = k1 * z2 - k2 * z1;
+            if det > 0.0 {
+                lines.push(LoadLine {
+                    k: ((z2 - z1) / det).max(0.0),
+                    z: ((k1 - k2) / det).max(0.0),
+                });
+            }
+        }
+    }
+    (!lines.is_empty()).then(|| StabilityEnvelope::from_loads(lines).scaled(1.0))
+}
+
 /// The envelope of the model's current parameter values, unscaled.
 pub fn raw_envelope(engine: &mut Engine) -> StabilityEnvelope {
     let coupled = |r: &crate::StabilityReport| -> Vec<f64> {

@@ -3,9 +3,10 @@
 //! the note input, stability envelopes, macro bindings, the reference pitch, scratch
 //! buffers). The audio thread then only runs a [`Prepared`] model.
 
-use super::envelope::{envelope, raw_envelope, worst_load, StabilityEnvelope};
+use super::envelope::{envelope, exact_envelope, raw_envelope, worst_load, StabilityEnvelope};
 use super::host::HostSettings;
 use super::macros::{macro_bindings, MacroBinding};
+use super::units::{unit_of, MacroUnit};
 use super::voices::VoiceBank;
 use super::CHUNK;
 use crate::{
@@ -63,6 +64,8 @@ pub struct Prepared {
     /// model the same momentum at any sample rate. 1 in `~samplerate raw` scripts.
     pub strike_scale: f64,
     pub macros: Vec<Option<MacroBinding>>,
+    /// How each macro slot reads (Hz, T60, ratio, 0 … 1 or its value), by slot.
+    pub macro_units: Vec<MacroUnit>,
     pub envelope: StabilityEnvelope,
     /// Per macro slot: the envelopes with its param at the range's minimum and maximum (the
     /// others at their declared values).
@@ -159,9 +162,12 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
 
     let mut settings = settings;
     if settings.reference_pitch_hz.is_none() {
-        settings.reference_pitch_hz = estimate_pitch(&mut engine, note_input, &roles);
+        settings.reference_pitch_hz = reference_pitch(&mut engine, note_input, &roles);
     }
-    let envelope = envelope(&mut engine);
+    // The exact limit where it applies; the Gershgorin envelope (whose scale the macro
+    // envelopes share) otherwise.
+    let gershgorin = envelope(&mut engine);
+    let envelope = exact_envelope(&mut engine).unwrap_or_else(|| gershgorin.clone());
     let report = engine.stability();
     let worst_load = worst_load(&report);
     let macros = macro_bindings(&mut engine, &settings);
@@ -175,10 +181,12 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
                 let high = raw_envelope(&mut engine);
                 let _ = engine.set_param(b.param, b.default);
                 engine.apply_pending_changes();
-                (low.scaled(envelope.scale), high.scaled(envelope.scale))
+                (low.scaled(gershgorin.scale), high.scaled(gershgorin.scale))
             })
         })
         .collect();
+
+    let macro_units = macro_units(&mut engine, &macros, note_input);
 
     let rate = match spec.sample_rate_mode {
         SampleRateMode::Scaled => REFERENCE_SAMPLE_RATE_HZ / sample_rate,
@@ -198,6 +206,7 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
         force_scale: rate * rate,
         strike_scale: rate,
         macros,
+        macro_units,
         envelope,
         macro_envelopes,
         worst_load,
@@ -206,6 +215,70 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
         name: name.to_string(),
         engine,
     })
+}
+
+/// The model's reference pitch (issue 14): the strongest mode that `@out1` hears from the note
+/// input, by the modal analysis ([`crate::modes`]) — dense and exact up to
+/// [`crate::modes::DENSE_LIMIT`] moving points. Larger models (and models the analysis cannot
+/// read, a note input with no linear path) fall back to the impulse response's strongest peak
+/// ([`estimate_pitch`]), within its work budget.
+fn reference_pitch(
+    engine: &mut Engine,
+    note_input: Option<usize>,
+    roles: &[InputRole],
+) -> Option<f64> {
+    let k = note_input?;
+    if engine.info().num_outputs() == 0 {
+        return None;
+    }
+    if engine.info().num_points <= crate::modes::DENSE_LIMIT {
+        if let Some(f) = engine.reference_pitch(k + 1, 1).filter(|f| *f > 0.0) {
+            return Some(f);
+        }
+    }
+    estimate_pitch(engine, note_input, roles)
+}
+
+/// Time the macro units may take while a model is prepared; slots left when it runs out read
+/// as values.
+const UNITS_BUDGET_S: f64 = 0.25;
+
+/// The unit of every macro slot ([`super::units`]): frequencies and decays of the reference
+/// mode (the strongest from the note input, or `@in1`, to `@out1`) come from the dense modal
+/// analysis, for models up to [`crate::modes::DENSE_LIMIT`] points, within
+/// [`UNITS_BUDGET_S`].
+fn macro_units(
+    engine: &mut Engine,
+    macros: &[Option<MacroBinding>],
+    note_input: Option<usize>,
+) -> Vec<MacroUnit> {
+    let small = engine.info().num_points <= crate::modes::DENSE_LIMIT;
+    let input = note_input.unwrap_or(0) + 1;
+    let params = engine.info().params.clone();
+    let mut reference = |e: &mut Engine| -> Option<(f64, f64)> {
+        if !small || e.info().num_outputs() == 0 {
+            return None;
+        }
+        let a = e.modes(None);
+        a.strongest(input, 1, 20.0)
+            .map(|m| (m.frequency_hz, m.t60_s))
+    };
+    let started = std::time::Instant::now();
+    macros
+        .iter()
+        .map(|b| match b {
+            Some(b) => {
+                let p = &params[b.param.0 as usize];
+                if started.elapsed().as_secs_f64() > UNITS_BUDGET_S {
+                    // Out of time: positions still read as positions, the rest as values.
+                    let mut none = |_: &mut Engine| None;
+                    return unit_of(engine, b, p.coordinate, &mut none);
+                }
+                unit_of(engine, b, p.coordinate, &mut reference)
+            }
+            None => MacroUnit::Value,
+        })
+        .collect()
 }
 
 /// Work budget of the pitch estimate, in element-steps: small models get a long window,

@@ -5,9 +5,10 @@
 //!
 //! What a parameter is comes from the stability analysis (spec §5.2): moving it changes the
 //! masses' M, or their attached stiffness K_eq, or damping Z_eq. The frequencies and decays
-//! come from the modal analysis ([`crate::modes`]) at a few slot positions, and are
-//! interpolated between them: geometric in the value between the slot's ends, so piecewise
-//! log-linear, as the frequency of a mode is in its stiffness.
+//! come from the modal analysis ([`crate::modes`]) at the slot's ends and its centre, and are
+//! interpolated between them: the slot is geometric in the value on each side of its centre,
+//! and a mode's frequency a power of its stiffness in the low-frequency limit, so piecewise
+//! log-linear.
 
 use super::macros::MacroBinding;
 use crate::{Engine, StabilityReport};
@@ -121,8 +122,10 @@ pub fn role(engine: &mut Engine, b: &MacroBinding) -> Role {
         .map_or(Role::Other, |c| c.1)
 }
 
-/// Slot positions at which the reference mode is measured.
-const TABLE_POSITIONS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+/// Slot positions at which the reference mode is measured: the ends and the declared value.
+/// Between them the slot is geometric in the value, and a mode's frequency (or decay) a power
+/// of it in the low-frequency limit, so log-linear interpolation is close.
+const TABLE_POSITIONS: [f64; 3] = [0.0, 0.5, 1.0];
 
 /// The unit of slot `b`. `reference(engine)` measures the reference mode of the engine as it
 /// stands: (frequency in Hz, T60 in s), or None where the analysis does not apply; it is
