@@ -1054,6 +1054,89 @@ impl NiceEguiApp for EditorApp {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nice_plug::prelude::{Param, PluginApi};
+    use std::sync::Mutex;
+
+    /// A host's side of the editor's context that records the parameter gestures.
+    #[derive(Default)]
+    struct Recorder {
+        calls: Mutex<Vec<String>>,
+        model_edits: Mutex<Option<nice_plug::params::internals::ParamPtr>>,
+    }
+
+    // SAFETY: the test touches the pointer only to compare it.
+    unsafe impl Send for Recorder {}
+    unsafe impl Sync for Recorder {}
+
+    impl Recorder {
+        fn name(&self, p: nice_plug::params::internals::ParamPtr) -> &'static str {
+            if Some(p) == *self.model_edits.lock().unwrap() {
+                "model_edits"
+            } else {
+                "other"
+            }
+        }
+    }
+
+    impl nice_plug::context::gui::GuiContextInner for Recorder {
+        fn plugin_api(&self) -> PluginApi {
+            PluginApi::Clap
+        }
+        unsafe fn raw_begin_set_parameter(&self, p: nice_plug::params::internals::ParamPtr) {
+            let n = self.name(p);
+            self.calls.lock().unwrap().push(format!("begin {n}"));
+        }
+        unsafe fn raw_set_parameter_normalized(
+            &self,
+            p: nice_plug::params::internals::ParamPtr,
+            v: f32,
+        ) {
+            let n = self.name(p);
+            self.calls.lock().unwrap().push(format!("set {n} {v:.4}"));
+        }
+        unsafe fn raw_end_set_parameter(&self, p: nice_plug::params::internals::ParamPtr) {
+            let n = self.name(p);
+            self.calls.lock().unwrap().push(format!("end {n}"));
+        }
+        fn get_state(&self) -> nice_plug::prelude::PluginState {
+            nice_plug::prelude::PluginState {
+                version: String::new(),
+                params: Default::default(),
+                fields: Default::default(),
+            }
+        }
+        fn set_state(&self, _: nice_plug::prelude::PluginState) {}
+        fn request_restart(&self) {}
+    }
+
+    #[test]
+    fn a_model_change_in_the_editor_is_an_edit_the_host_records() {
+        // Every model change the editor makes moves the hidden Model Edits parameter with a
+        // full gesture, which hosts record as an edit of the project; a script with errors
+        // changes nothing and records nothing.
+        let store = Arc::new(ModelStore::default());
+        let params = Arc::new(RessortParams::new(store.clone()));
+        let recorder = Arc::new(Recorder::default());
+        *recorder.model_edits.lock().unwrap() = Some(params.model_edits.as_ptr());
+        let mut app = EditorApp::new(params, store.clone());
+        app.gui = Some(GuiContext::new(recorder.clone()));
+        let harmonic = Preset::find("harmonic-oscillator").unwrap();
+        app.submit(harmonic.id.into(), harmonic.text.into());
+        assert_eq!(
+            *recorder.calls.lock().unwrap(),
+            [
+                "begin model_edits",
+                "set model_edits 0.0039",
+                "end model_edits"
+            ]
+        );
+        recorder.calls.lock().unwrap().clear();
+        app.submit("broken".into(), "@o osc 1. 0.1\n".into());
+        assert!(
+            recorder.calls.lock().unwrap().is_empty(),
+            "a rejected script is no edit"
+        );
+    }
 
     #[test]
     fn diagnostics_split_into_position_and_message() {
