@@ -208,6 +208,24 @@ fn check(a: &CheckArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// The error for a `--set` of a parameter the model does not declare, listing the ones it does.
+pub(crate) fn unknown_parameter(engine: &Engine, name: &str) -> Failure {
+    let names: Vec<&str> = engine
+        .info()
+        .params
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect();
+    usage(format!(
+        "unknown parameter `{name}`; the model's parameters are: {}",
+        if names.is_empty() {
+            "(none)".to_string()
+        } else {
+            names.join(", ")
+        }
+    ))
+}
+
 /// Splits `inK=VALUE` into the 0-based channel and the value text.
 fn input_assignment<'a>(text: &'a str, engine: &Engine) -> Result<(usize, &'a str), Failure> {
     let (name, value) = text
@@ -327,17 +345,9 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
         let v: f64 = value
             .parse()
             .map_err(|_| usage(format!("`{value}` is not a number (in --set {s})")))?;
-        let id = engine.param_id(name).ok_or_else(|| {
-            let names: Vec<&str> = info.params.iter().map(|p| p.name.as_str()).collect();
-            usage(format!(
-                "unknown parameter `{name}`; the model's parameters are: {}",
-                if names.is_empty() {
-                    "(none)".to_string()
-                } else {
-                    names.join(", ")
-                }
-            ))
-        })?;
+        let id = engine
+            .param_id(name)
+            .ok_or_else(|| unknown_parameter(&engine, name))?;
         engine
             .set_param(id, v)
             .map_err(|e| usage(format!("cannot set `{name}`: {e}")))?;

@@ -162,23 +162,10 @@ fn set_param(model: &mut Prepared, c: &mut Controls, text: &str) -> Result<(), F
         c.macros[slot] = b.normalized_of(v);
         return Ok(());
     }
-    let id = model.engine.param_id(name).ok_or_else(|| {
-        let names: Vec<&str> = model
-            .engine
-            .info()
-            .params
-            .iter()
-            .map(|p| p.name.as_str())
-            .collect();
-        usage(format!(
-            "unknown parameter `{name}`; the model's parameters are: {}",
-            if names.is_empty() {
-                "(none)".to_string()
-            } else {
-                names.join(", ")
-            }
-        ))
-    })?;
+    let id = model
+        .engine
+        .param_id(name)
+        .ok_or_else(|| crate::unknown_parameter(&model.engine, name))?;
     model
         .engine
         .set_param(id, v)

@@ -14,6 +14,7 @@ use crate::runtime::RuntimeStatus;
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::params::persist::PersistentField;
 use ressort_engine::instrument;
+pub use ressort_engine::instrument::units::format_value;
 use ressort_engine::instrument::units::MacroUnit;
 pub use ressort_engine::instrument::{
     parse_script, peak_frequency, HostSettings, InputRole, LoadLine, MacroBinding, Prepared,
@@ -144,21 +145,6 @@ pub fn summary(prepared: &mut Prepared) -> ModelSummary {
         reference_key: prepared.settings.reference_key,
         declared_voices: prepared.settings.voices,
         voices: prepared.voices(),
-    }
-}
-
-/// Four significant digits, without exponent for ordinary magnitudes.
-pub fn format_value(v: f64) -> String {
-    let a = v.abs();
-    if a != 0.0 && !(1e-3..1e5).contains(&a) {
-        format!("{v:.3e}")
-    } else {
-        let digits = if a >= 1.0 {
-            3 - a.log10().floor() as i32
-        } else {
-            4
-        };
-        format!("{v:.*}", digits.clamp(0, 6) as usize)
     }
 }
 

@@ -60,6 +60,44 @@ pub const MAX_HOST_INPUTS: usize = 10;
 /// `@out3` … `@out8` on auxiliary outputs.
 pub const MAX_HOST_OUTPUTS: usize = 8;
 
+/// The stability clamp's view of a prepared model `m`, borrowing only the fields it reads (so
+/// its voice bank stays free to change).
+macro_rules! clamp_view {
+    ($m:expr) => {
+        ClampView {
+            reference_pitch_hz: $m.settings.reference_pitch_hz,
+            sample_rate: $m.sample_rate,
+            envelope: &$m.envelope,
+            macros: &$m.macros,
+            macro_envelopes: &$m.macro_envelopes,
+        }
+    };
+}
+
+/// Puts a voice's gains on its engine: its note, MPE bend and tuning, its polyphonic
+/// modulation, and the Release damper (`release`, a Damping factor) once its key is up.
+fn tune_voice(
+    smoothed: &Smoothed,
+    view: &ClampView<'_>,
+    v: &mut voices::Voice,
+    release: f64,
+) -> Gains {
+    let z = if v.state == VoiceState::Released {
+        release
+    } else {
+        1.0
+    };
+    let g = smoothed.gains_offset(
+        view,
+        v.note_st + v.bend_st + v.tuning_st,
+        z,
+        v.mod_k,
+        v.mod_z,
+    );
+    smoothed.set(&mut v.engine, view.macros, &g);
+    g
+}
+
 /// A value in 0 … 1 (NaN reads 0).
 fn unit(v: f32) -> f64 {
     if v.is_finite() {
@@ -300,13 +338,7 @@ impl Instrument {
             self.gains = self.smoothed.apply(m, self.note_st + self.tuning_st);
             return;
         };
-        let view = ClampView {
-            reference_pitch_hz: m.settings.reference_pitch_hz,
-            sample_rate: m.sample_rate,
-            envelope: &m.envelope,
-            macros: &m.macros,
-            macro_envelopes: &m.macro_envelopes,
-        };
+        let view = clamp_view!(m);
         let release = 16f64.powf(self.controls.release);
         // The model itself, which the host's audio plays, at the reference key.
         let mut shown = self.smoothed.gains(&view, 0.0, 1.0);
@@ -316,19 +348,7 @@ impl Instrument {
             if v.state == VoiceState::Free {
                 continue;
             }
-            let z = if v.state == VoiceState::Released {
-                release
-            } else {
-                1.0
-            };
-            let g = self.smoothed.gains_offset(
-                &view,
-                v.note_st + v.bend_st + v.tuning_st,
-                z,
-                v.mod_k,
-                v.mod_z,
-            );
-            self.smoothed.set(&mut v.engine, view.macros, &g);
+            let g = tune_voice(&self.smoothed, &view, v, release);
             if v.started > newest {
                 newest = v.started;
                 shown = g;
@@ -345,29 +365,9 @@ impl Instrument {
         let Some(bank) = m.bank.as_mut() else {
             return;
         };
-        let view = ClampView {
-            reference_pitch_hz: m.settings.reference_pitch_hz,
-            sample_rate: m.sample_rate,
-            envelope: &m.envelope,
-            macros: &m.macros,
-            macro_envelopes: &m.macro_envelopes,
-        };
+        let view = clamp_view!(m);
         let release = 16f64.powf(self.controls.release);
-        let v = &mut bank.voices[i];
-        let z = if v.state == VoiceState::Released {
-            release
-        } else {
-            1.0
-        };
-        let g = self.smoothed.gains_offset(
-            &view,
-            v.note_st + v.bend_st + v.tuning_st,
-            z,
-            v.mod_k,
-            v.mod_z,
-        );
-        self.smoothed.set(&mut v.engine, view.macros, &g);
-        self.gains = g;
+        self.gains = tune_voice(&self.smoothed, &view, &mut bank.voices[i], release);
     }
 
     /// An expression event: MPE bend, pressure, note tuning, polyphonic modulation. Returns

@@ -295,38 +295,21 @@ impl Builder<'_> {
                     Some(args[0].source()),
                 ),
             },
-            "note" => {
-                let force = match args.get(1) {
-                    Some(t) => match number(t) {
-                        Some(v) => Some(v),
-                        None => {
-                            bad(
-                                &mut self.diags,
-                                t.col,
-                                "the note force must be a number".into(),
-                                Some(t.source()),
-                            );
-                            return;
-                        }
-                    },
-                    None => None,
-                };
-                if host.note_input.is_some() {
-                    conflict(&mut self.diags, "the model");
-                    return;
-                }
-                host.note_input = Some(k);
-                host.note_force = force;
-            }
-            "pressure" => {
+            "note" | "pressure" => {
+                // An input, then an optional number: the note's force or full pressure's amount.
                 let amount = match args.get(1) {
                     Some(t) => match number(t) {
                         Some(v) => Some(v),
                         None => {
+                            let what = if name == "note" {
+                                "the note force"
+                            } else {
+                                "the pressure amount"
+                            };
                             bad(
                                 &mut self.diags,
                                 t.col,
-                                "the pressure amount must be a number".into(),
+                                format!("{what} must be a number"),
                                 Some(t.source()),
                             );
                             return;
@@ -334,12 +317,17 @@ impl Builder<'_> {
                     },
                     None => None,
                 };
-                if host.pressure_input.is_some() {
+                let (input, value) = if name == "note" {
+                    (&mut host.note_input, &mut host.note_force)
+                } else {
+                    (&mut host.pressure_input, &mut host.pressure_scale)
+                };
+                if input.is_some() {
                     conflict(&mut self.diags, "the model");
                     return;
                 }
-                host.pressure_input = Some(k);
-                host.pressure_scale = amount;
+                *input = Some(k);
+                *value = amount;
             }
             "route" => {
                 let Some(source) = RouteSource::from_name(&args[1].string()) else {
