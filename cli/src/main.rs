@@ -302,6 +302,21 @@ pub(crate) fn read_wav_channels(path: &Path, sample_rate: u32) -> Result<Vec<Vec
         .collect())
 }
 
+/// A 32-bit float WAV writer with `channels` channels at `sample_rate`.
+pub(crate) fn float_wav(
+    path: &Path,
+    channels: usize,
+    sample_rate: u32,
+) -> Result<hound::WavWriter<std::io::BufWriter<std::fs::File>>, hound::Error> {
+    let spec = hound::WavSpec {
+        channels: channels as u16,
+        sample_rate,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    hound::WavWriter::create(path, spec)
+}
+
 /// The maximum length of a render: one hour at 192 kHz.
 pub(crate) const MAX_RENDER_SAMPLES: u64 = 192_000 * 3600;
 const RENDER_BLOCK_FRAMES: usize = 4096;
@@ -377,14 +392,8 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
     }
 
     let out_channels = info.num_outputs();
-    let wav_spec = hound::WavSpec {
-        channels: out_channels as u16,
-        sample_rate: sr,
-        bits_per_sample: 32,
-        sample_format: hound::SampleFormat::Float,
-    };
     let io = |e: hound::Error| usage(format!("cannot write {}: {e}", a.output.display()));
-    let mut writer = hound::WavWriter::create(&a.output, wav_spec).map_err(io)?;
+    let mut writer = float_wav(&a.output, out_channels, sr).map_err(io)?;
     let bar = ProgressBar::new(total);
     bar.set_style(
         ProgressStyle::with_template("{spinner} rendering [{bar:40}] {percent}% {eta} left")

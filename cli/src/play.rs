@@ -305,14 +305,8 @@ pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
     inst.set_main_input(has_main);
     inst.set_model(Box::new(model));
 
-    let wav_spec = hound::WavSpec {
-        channels: channels as u16,
-        sample_rate: sr,
-        bits_per_sample: 32,
-        sample_format: hound::SampleFormat::Float,
-    };
     let io = |e: hound::Error| usage(format!("cannot write {}: {e}", a.output.display()));
-    let mut writer = hound::WavWriter::create(&a.output, wav_spec).map_err(io)?;
+    let mut writer = crate::float_wav(&a.output, channels, sr).map_err(io)?;
     let mut out: Vec<Vec<f32>> = vec![vec![0.0; BLOCK]; channels];
     let mut next_event = 0;
     let (mut done, mut peak, mut trips) = (0u64, 0.0f32, 0u32);

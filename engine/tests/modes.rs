@@ -373,10 +373,8 @@ fn exact_limit_of_an_undamped_string_is_the_closed_form() {
     assert!(e.exact_stability().max_damping(1.0).unwrap().is_infinite());
 }
 
-/// On every preset the exact limit applies and is at least the Gershgorin bound (a diagonally
-/// dominant 4M − K − 2Z is positive definite).
-#[test]
-fn exact_limit_is_never_below_the_gershgorin_bound_on_the_presets() {
+/// The file names of the preset scripts in models/, sorted.
+fn preset_names() -> Vec<String> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
     let mut names: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
@@ -385,7 +383,14 @@ fn exact_limit_is_never_below_the_gershgorin_bound_on_the_presets() {
         .filter(|n| n.ends_with(".mdl"))
         .collect();
     names.sort();
-    for name in names {
+    names
+}
+
+/// On every preset the exact limit applies and is at least the Gershgorin bound (a diagonally
+/// dominant 4M − K − 2Z is positive definite).
+#[test]
+fn exact_limit_is_never_below_the_gershgorin_bound_on_the_presets() {
+    for name in preset_names() {
         let mut e = engine(&preset(&name), 44_100.0);
         let gersh = e.gershgorin_stiffness_limit(1.0);
         let StiffnessLimit::Exact(exact) = e.stiffness_limit(1.0) else {
@@ -402,15 +407,7 @@ fn exact_limit_is_never_below_the_gershgorin_bound_on_the_presets() {
 #[test]
 #[ignore = "a report, not a check: hammers make the rendered response nonlinear"]
 fn reference_pitch_against_the_fft_estimate() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
-    let mut names: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".mdl"))
-        .collect();
-    names.sort();
-    for name in names {
+    for name in preset_names() {
         let mut e = engine(&preset(&name), 44_100.0);
         let Some(input) = e.info().inputs.iter().position(|u| {
             u.iter()

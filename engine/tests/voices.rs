@@ -6,16 +6,9 @@ use ressort_engine::instrument::{self, Controls, Event, Instrument, Timed, MAX_H
 
 const SR: f64 = 48_000.0;
 
-/// An oscillator struck through a hammer (a contact: each voice is nonlinear on its own).
-const STRUCK: &str = "\
-@o osc 1. 0.02 0.0002 0. 0.
-@g ground 0.1
-@h mass 1. 0.1 0.
-@hs springDamper @g @h 0.0001 0.01
-@hit contact @o @h 0.1 0.001
-@in1 frcInput @h
-@out1 posOutput @o
-";
+/// An oscillator struck through a hammer (a contact: each voice is nonlinear on its own),
+/// shared with the plugin's polyphony tests.
+const STRUCK: &str = include_str!("../../tests/models/struck-oscillator.mdl");
 
 /// A strongly damped oscillator struck directly: it comes to rest within a second.
 const DAMPED: &str = "\

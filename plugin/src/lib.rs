@@ -193,10 +193,39 @@ impl Ressort {
         self.pending_strike |= strike;
     }
 
-    /// Publishes what the instrument did to the editor and the host.
-    fn report(&mut self, trips: u32, context: &mut impl ProcessContext<Self>) {
+    /// A new Voices setting: CLAP re-prepares the model on the main thread at once; other
+    /// formats at the next activation or when the editor sees it.
+    fn follow_voices_setting(&mut self, context: &mut impl ProcessContext<Self>) {
+        if !self.store.voices_stale() {
+            self.voices_task_queued = false;
+        } else if !std::mem::replace(&mut self.voices_task_queued, true)
+            && context.plugin_api() == PluginApi::Clap
+        {
+            context.execute_gui(MainThreadTask::ApplyVoices);
+        }
+    }
+
+    /// Publishes what the instrument did in a block of `frames` to the editor (gains, macro
+    /// positions, voices) and to the host (voices that ended, guard trips).
+    fn report(&mut self, trips: u32, frames: usize, context: &mut impl ProcessContext<Self>) {
+        // Voices that ended: CLAP hosts end their polyphonic modulation there.
+        let last = frames.saturating_sub(1) as u32;
+        self.instrument.drain_ended(|e| {
+            let _ = context.try_send_event(NoteEvent::VoiceTerminated {
+                timing: last,
+                voice_id: e.voice_id.map_or(VoiceID::Wildcard, VoiceID::ID),
+                channel: Channel::Number(e.channel),
+                key: Key::Number(e.note),
+            });
+        });
         let g = self.instrument.gains();
         let rt = &self.store.runtime;
+        for (a, v) in rt.macros.iter().zip(self.instrument.macros()) {
+            a.store(v, Ordering::Relaxed);
+        }
+        let (sounding, total) = self.instrument.voice_count();
+        rt.voices_sounding.store(sounding as u32, Ordering::Relaxed);
+        rt.voices_total.store(total as u32, Ordering::Relaxed);
         rt.stiffness_gain.store(g.stiffness, Ordering::Relaxed);
         rt.damping_gain.store(g.damping, Ordering::Relaxed);
         rt.requested_stiffness_gain
@@ -504,38 +533,10 @@ impl Plugin for Ressort {
         );
         drop(events);
         self.audition_left = self.audition_left.saturating_sub(frames as u64);
-        let macros = self.instrument.macros();
-        for (a, v) in self.store.runtime.macros.iter().zip(macros) {
-            a.store(v, Ordering::Relaxed);
-        }
         let retired = self.instrument.take_retired();
         self.recycle(retired);
-        self.report(report.trips, context);
-        // Voices that ended: CLAP hosts end their polyphonic modulation there.
-        let last = frames.saturating_sub(1) as u32;
-        self.instrument.drain_ended(|e| {
-            let _ = context.try_send_event(NoteEvent::VoiceTerminated {
-                timing: last,
-                voice_id: e.voice_id.map_or(VoiceID::Wildcard, VoiceID::ID),
-                channel: Channel::Number(e.channel),
-                key: Key::Number(e.note),
-            });
-        });
-        let (sounding, total) = self.instrument.voice_count();
-        let rt = &self.store.runtime;
-        rt.voices_sounding.store(sounding as u32, Ordering::Relaxed);
-        rt.voices_total.store(total as u32, Ordering::Relaxed);
-        // A new Voices setting: CLAP runs the re-preparation on the main thread now; other
-        // formats at the next activation or when the editor sees it.
-        if self.store.voices_stale()
-            && !std::mem::replace(&mut self.voices_task_queued, true)
-            && context.plugin_api() == PluginApi::Clap
-        {
-            context.execute_gui(MainThreadTask::ApplyVoices);
-        }
-        if !self.store.voices_stale() {
-            self.voices_task_queued = false;
-        }
+        self.report(report.trips, frames, context);
+        self.follow_voices_setting(context);
 
         let rt = &self.store.runtime;
         let seconds = frames as f64 / self.sample_rate;

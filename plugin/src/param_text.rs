@@ -104,23 +104,6 @@ pub fn parse_switch(text: &str, off: &str, on: &str) -> Option<bool> {
     }
 }
 
-/// The value in a macro's text: `K = 0.1200` gives 0.12 when the slot is bound to `K`; a
-/// bare number is the value too. `None` when the text is not a number.
-pub fn parse_bound_macro(text: &str, name: &str) -> Option<f64> {
-    let t = clean(text);
-    let value = match t.split_once('=') {
-        Some((lhs, rhs)) => {
-            let lhs = lhs.trim();
-            if !lhs.is_empty() && lhs != name {
-                return None;
-            }
-            rhs
-        }
-        None => t.as_str(),
-    };
-    number(value)
-}
-
 /// The text of an unbound macro slot: its position in percent.
 pub fn format_unbound_macro(normalized: f64) -> String {
     format!("unbound ({:.0} %)", normalized * 100.0)
@@ -210,10 +193,6 @@ mod tests {
         assert_eq!(parse_switch("clear", "Clear", "Tripped"), Some(false));
         assert_eq!(parse_switch("On", "Clear", "Tripped"), Some(true));
         assert_eq!(parse_switch("maybe", "Clear", "Tripped"), None);
-        assert_eq!(parse_bound_macro("K = 0.1200", "K"), Some(0.12));
-        assert_eq!(parse_bound_macro("0.12", "K"), Some(0.12));
-        assert_eq!(parse_bound_macro("Z = 0.12", "K"), None);
-        assert_eq!(parse_bound_macro("K = 1.000e-6", "K"), Some(1e-6));
         assert_eq!(parse_unbound_macro(&format_unbound_macro(0.5)), Some(0.5));
         assert_eq!(parse_unbound_macro("25%"), Some(0.25));
         assert_eq!(parse_unbound_macro("0.3"), Some(0.3));

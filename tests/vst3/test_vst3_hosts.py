@@ -138,15 +138,7 @@ def test_pedalboard_plays_midi_notes_at_their_pitch(preset_dir):
 
 
 #: A hammer on an oscillator: each voice is nonlinear on its own.
-STRUCK = """# A hammer on an oscillator (polyphony test).
-@o osc 1. 0.02 0.0002 0. 0.
-@g ground 0.1
-@h mass 1. 0.1 0.
-@hs springDamper @g @h 0.0001 0.01
-@hit contact @o @h 0.1 0.001
-@in1 frcInput @h
-@out1 posOutput @o
-"""
+STRUCK = shared_script("struck-oscillator.mdl")
 
 
 def test_pedalboard_plays_a_chord_as_the_sum_of_its_notes(preset_dir):

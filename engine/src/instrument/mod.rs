@@ -247,10 +247,6 @@ impl Instrument {
         self.current.as_deref()
     }
 
-    pub fn model_mut(&mut self) -> Option<&mut Prepared> {
-        self.current.as_deref_mut()
-    }
-
     /// The gains in use after the last chunk.
     pub fn gains(&self) -> Gains {
         self.gains
@@ -696,6 +692,11 @@ impl Instrument {
                 host_in.get(c).copied().flatten()
             };
             let src = src.and_then(|s| s.get(pos..)).unwrap_or(&[]);
+            if src.is_empty() {
+                // A channel the host does not feed: silence, nothing to measure.
+                row[..len].fill(0.0);
+                continue;
+            }
             for (i, d) in row[..len].iter_mut().enumerate() {
                 *d = src.get(i).copied().map_or(0.0, dsp::input_sample);
                 report.loudest = report.loudest.max(d.abs());
@@ -718,6 +719,7 @@ impl Instrument {
                         .for_each(|x| *x += add);
                 }
             }
+            let strike_force = m.strike_force(force);
             if let Some(bank) = m.bank.as_mut() {
                 // The model itself keeps playing what the host feeds it (a sidechain strikes
                 // it as without voices); notes play on voices of their own, which hear the
@@ -726,7 +728,6 @@ impl Instrument {
                     m.engine
                         .process(len, &m.inputs[..n_in * len], &mut m.outputs[..n_out * len]);
                 tripped |= r.tripped;
-                let strike_force = m.settings.note_force * m.strike_scale * force;
                 tripped |= bank.process(
                     len,
                     &m.inputs[..n_in * len],

@@ -331,6 +331,11 @@ mod tests {
         assert_eq!(v.text(&b, 0.5), "K = 0.1000");
         assert_eq!(v.position_of(&b, "K = 0.1000"), Some(0.5));
         assert_eq!(v.position_of(&b, "nonsense"), None);
+        // Exponent forms read too (formerly the plugin's own macro text parser).
+        assert_eq!(
+            v.position_of(&b, "K = 2.500e-2"),
+            Some(b.normalized_of(0.025))
+        );
         // Text → position → text is stable.
         for u in [&f, &d, &m, &v] {
             for i in 0..=20 {
