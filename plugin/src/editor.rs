@@ -12,6 +12,7 @@ use crate::files::{
     UserPreset,
 };
 use crate::model::{ModelState, ModelStatus, ModelStore, NUM_MACROS};
+use crate::modes_view::ModesView;
 use crate::motion::MotionReader;
 use crate::params::RessortParams;
 use crate::plot::{PlotState, ZMode};
@@ -37,6 +38,8 @@ pub const MIN_SIZE: (f32, f32) = (780.0, 500.0);
 /// Widths of the model panel (left) and the controls (right): minimum, default, maximum.
 const LEFT_PANEL: (f32, f32, f32) = (240.0, 380.0, 700.0);
 const RIGHT_PANEL: (f32, f32, f32) = (240.0, 300.0, 480.0);
+/// Height of the Modes view: minimum, default, maximum.
+const MODES_HEIGHT: (f32, f32, f32) = (150.0, 210.0, 480.0);
 /// The width the side panels leave to the motion view when the window allows it.
 const MIN_VIEW_WIDTH: f32 = 300.0;
 
@@ -120,6 +123,9 @@ pub struct EditorApp {
     reported_trips: u32,
     reader: Option<MotionReader>,
     plot: PlotState,
+    /// The Modes view under the motion view, and whether it is open.
+    modes: ModesView,
+    modes_open: bool,
     tab: Tab,
     preset: usize,
     /// The text in the script editor, and the name it will be applied under.
@@ -167,6 +173,8 @@ impl EditorApp {
             reported_trips: 0,
             reader: None,
             plot: PlotState::default(),
+            modes: ModesView::default(),
+            modes_open: true,
             tab,
             preset,
             message: None,
@@ -914,6 +922,32 @@ impl EditorApp {
             });
     }
 
+    /// The Modes view under the motion view: follows the running model and the controls in
+    /// use (the macro slots as the audio thread last used them, MIDI-learned controllers
+    /// included).
+    fn modes_panel(&mut self, ui: &mut Ui) {
+        if self.modes_open {
+            let mut controls = self.params.controls();
+            for (c, used) in controls.macros.iter_mut().zip(&self.store.runtime.macros) {
+                *c = used.load(Ordering::Relaxed);
+            }
+            self.modes.update(self.store.modal_model(), controls);
+        }
+        // One id per state: the open panel keeps its own (resizable) height.
+        let panel = if self.modes_open {
+            egui::Panel::bottom("modes_open")
+                .resizable(true)
+                .default_size(MODES_HEIGHT.1)
+                .size_range(MODES_HEIGHT.0..=MODES_HEIGHT.2)
+        } else {
+            egui::Panel::bottom("modes_closed").resizable(false)
+        };
+        panel.show(ui, |ui| {
+            ui.add_space(2.0);
+            self.modes.show(ui, &mut self.modes_open);
+        });
+    }
+
     fn motion_panel(&mut self, ui: &mut Ui, dt: f32) {
         let Some(reader) = self.reader.as_mut() else {
             ui.centered_and_justified(|ui| {
@@ -955,8 +989,17 @@ impl EditorApp {
                     .on_disabled_hover_text("1-D selections show z vertically");
             });
             ui.checkbox(&mut self.plot.hold, "Hold scale");
+            if let Some((k, _)) = self.modes.selected_mode() {
+                ui.colored_label(ORANGE, format!("showing the shape of mode {}", k + 1));
+                if ui.small_button("live motion").clicked() {
+                    self.modes.selected = None;
+                }
+            }
         });
-        self.plot.show(ui, &view, &reader.latest().z, dt);
+        match self.modes.shape_frame(&view.rest, dt) {
+            Some(shape) => self.plot.show(ui, &view, shape, dt),
+            None => self.plot.show(ui, &view, &reader.latest().z, dt),
+        };
     }
 }
 
@@ -1041,6 +1084,7 @@ impl NiceEguiApp for EditorApp {
                         self.model_status(ui, &status);
                     });
             });
+        self.modes_panel(ui);
         egui::CentralPanel::default_margins().show(ui, |ui| self.motion_panel(ui, dt));
         // Redraw continuously while open: the window system paces the frames.
         ui.ctx().request_repaint();

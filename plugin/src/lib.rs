@@ -23,6 +23,8 @@ pub mod editor;
 pub mod files;
 pub mod midi_learn;
 pub mod model;
+pub mod modes_view;
+pub mod modes_worker;
 pub mod motion;
 pub mod param_text;
 pub mod params;

@@ -16,6 +16,7 @@ use nice_plug::params::persist::PersistentField;
 use ressort_engine::instrument;
 pub use ressort_engine::instrument::units::format_value;
 use ressort_engine::instrument::units::MacroUnit;
+use ressort_engine::instrument::ModalModel;
 pub use ressort_engine::instrument::{
     parse_script, peak_frequency, HostSettings, InputRole, LoadLine, MacroBinding, Prepared,
     Rejected, StabilityEnvelope, CHUNK, NUM_MACROS, STABILITY_HEADROOM,
@@ -178,6 +179,8 @@ pub struct ModelStore {
     voices_stale: AtomicBool,
     /// The A/B compare slots (not saved with the project).
     compare: Mutex<Compare>,
+    /// A copy of the running model for the editor's modal analysis, made when it was prepared.
+    modal: Mutex<Option<Arc<ModalModel>>>,
     /// What the audio thread reports.
     pub runtime: RuntimeStatus,
 }
@@ -197,6 +200,7 @@ impl Default for ModelStore {
             garbage: crossbeam_channel::bounded(64),
             motion: Mutex::new(None),
             compare: Mutex::new(Compare::default()),
+            modal: Mutex::new(None),
             voices: AtomicU64::new(0),
             voices_stale: AtomicBool::new(false),
             runtime: RuntimeStatus::default(),
@@ -243,6 +247,11 @@ impl ModelStore {
         }
     }
 
+    /// The running model for the modal analysis (None before the first activation).
+    pub fn modal_model(&self) -> Option<Arc<ModalModel>> {
+        lock(&self.modal).clone()
+    }
+
     /// The motion reader of the newest model, once: the editor keeps it until a newer model
     /// arrives.
     pub fn take_motion_reader(&self) -> Option<MotionReader> {
@@ -280,6 +289,7 @@ impl ModelStore {
                 if let Some((mut p, reader)) = prepared {
                     status.summary = summary(&mut p);
                     drop(status);
+                    *lock(&self.modal) = Some(Arc::new(ModalModel::of(&p)));
                     *lock(&self.motion) = Some(reader);
                     self.send(Box::new(p));
                 }
@@ -413,6 +423,7 @@ impl ModelStore {
             }
         };
         lock(&self.status).summary = summary(&mut prepared);
+        *lock(&self.modal) = Some(Arc::new(ModalModel::of(&prepared)));
         *lock(&self.motion) = Some(reader);
         Some(Box::new(prepared))
     }

@@ -410,13 +410,24 @@ impl Stereo {
 /// [`Block::events`], from the start of the render in [`Score::events`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum HostEvent {
-    /// A CLAP note-on on note port 0, channel 0; `velocity` in 0..=1.
-    NoteOn { time: u32, key: u8, velocity: f64 },
-    /// A CLAP note-off on note port 0, channel 0.
-    NoteOff { time: u32, key: u8, velocity: f64 },
-    /// A MIDI 1 pitch bend on channel 0 (`value` in -1..=1, 0 = centre), sent as a 14-bit
-    /// CLAP MIDI event.
-    PitchBend { time: u32, value: f64 },
+    /// A CLAP note-on on note port 0 and MIDI channel `channel` (0 … 15); `velocity` in
+    /// 0..=1.
+    NoteOn {
+        time: u32,
+        key: u8,
+        velocity: f64,
+        channel: u8,
+    },
+    /// A CLAP note-off on note port 0 and MIDI channel `channel`.
+    NoteOff {
+        time: u32,
+        key: u8,
+        velocity: f64,
+        channel: u8,
+    },
+    /// A MIDI 1 pitch bend on MIDI channel `channel` (`value` in -1..=1, 0 = centre), sent as
+    /// a 14-bit CLAP MIDI event.
+    PitchBend { time: u32, value: f64, channel: u8 },
     /// A MIDI 1 control change on channel 0 (`value` 0..=127), as a CLAP MIDI event.
     Controller { time: u32, cc: u8, value: u8 },
     /// A parameter change to a plain value.
@@ -455,21 +466,29 @@ impl HostEvent {
     }
 
     fn push_to(&self, buffer: &mut EventBuffer) {
-        let note = |key: u8| Pckn::new(0u16, 0u16, key as u16, Match::<u32>::All);
+        let note = |key: u8, channel: u8| {
+            Pckn::new(0u16, (channel & 0x0f) as u16, key as u16, Match::<u32>::All)
+        };
         match *self {
             HostEvent::NoteOn {
                 time,
                 key,
                 velocity,
-            } => buffer.push(&NoteOnEvent::new(time, note(key), velocity)),
+                channel,
+            } => buffer.push(&NoteOnEvent::new(time, note(key, channel), velocity)),
             HostEvent::NoteOff {
                 time,
                 key,
                 velocity,
-            } => buffer.push(&NoteOffEvent::new(time, note(key), velocity)),
-            HostEvent::PitchBend { time, value } => {
+                channel,
+            } => buffer.push(&NoteOffEvent::new(time, note(key, channel), velocity)),
+            HostEvent::PitchBend {
+                time,
+                value,
+                channel,
+            } => {
                 let v = Self::pitch_bend_14bit(value);
-                let data = [0xE0, (v & 0x7f) as u8, (v >> 7) as u8];
+                let data = [0xE0 | (channel & 0x0f), (v & 0x7f) as u8, (v >> 7) as u8];
                 buffer.push(&MidiEvent::new(time, 0, data));
             }
             HostEvent::Controller { time, cc, value } => {
@@ -556,24 +575,43 @@ impl Score {
         self
     }
 
+    /// A note-on on MIDI channel 0.
     pub fn note_on(self, frame: u32, key: u8, velocity: f64) -> Score {
+        self.note_on_channel(frame, key, velocity, 0)
+    }
+
+    /// A note-on on MIDI channel `channel` (0 … 15; MPE member channels are 1 … 15).
+    pub fn note_on_channel(self, frame: u32, key: u8, velocity: f64, channel: u8) -> Score {
         self.event(HostEvent::NoteOn {
             time: frame,
             key,
             velocity,
+            channel,
         })
     }
 
+    /// A note-off on MIDI channel 0.
     pub fn note_off(self, frame: u32, key: u8) -> Score {
         self.event(HostEvent::NoteOff {
             time: frame,
             key,
             velocity: 0.0,
+            channel: 0,
         })
     }
 
+    /// A pitch bend on MIDI channel 0.
     pub fn pitch_bend(self, frame: u32, value: f64) -> Score {
-        self.event(HostEvent::PitchBend { time: frame, value })
+        self.pitch_bend_channel(frame, value, 0)
+    }
+
+    /// A pitch bend on MIDI channel `channel`.
+    pub fn pitch_bend_channel(self, frame: u32, value: f64, channel: u8) -> Score {
+        self.event(HostEvent::PitchBend {
+            time: frame,
+            value,
+            channel,
+        })
     }
 
     /// A MIDI control change (0..=127) on channel 0.

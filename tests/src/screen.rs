@@ -278,6 +278,34 @@ pub fn window_names(display: &str) -> Vec<String> {
         .collect()
 }
 
+/// Clicks the left button at (`x`, `y`) in `window` through the XTEST extension, as a user's
+/// pointer would.
+pub fn click(display: &str, window: Window, x: i16, y: i16) -> Result<(), String> {
+    use x11rb::protocol::xproto::{BUTTON_PRESS_EVENT, BUTTON_RELEASE_EVENT, MOTION_NOTIFY_EVENT};
+    use x11rb::protocol::xtest::ConnectionExt as _;
+    use x11rb::wrapper::ConnectionExt as _;
+    let (conn, screen) = x11rb::connect(Some(display)).map_err(|e| e.to_string())?;
+    let root = conn.setup().roots[screen].root;
+    let at = conn
+        .translate_coordinates(window, root, x, y)
+        .map_err(|e| e.to_string())?
+        .reply()
+        .map_err(|e| e.to_string())?;
+    let fake = |kind: u8, detail: u8| {
+        conn.xtest_fake_input(kind, detail, 0, root, at.dst_x, at.dst_y, 0)
+            .map_err(|e| e.to_string())
+    };
+    fake(MOTION_NOTIFY_EVENT, 0)?;
+    conn.flush().map_err(|e| e.to_string())?;
+    std::thread::sleep(Duration::from_millis(100));
+    fake(BUTTON_PRESS_EVENT, 1)?;
+    conn.flush().map_err(|e| e.to_string())?;
+    std::thread::sleep(Duration::from_millis(80));
+    fake(BUTTON_RELEASE_EVENT, 1)?;
+    conn.sync().map_err(|e| e.to_string())?;
+    Ok(())
+}
+
 /// Captures a window's contents (a 24-bit TrueColor window, as Xvfb and baseview make).
 pub fn capture(display: &str, window: Window) -> Result<Image, String> {
     let (conn, _) = x11rb::connect(Some(display)).map_err(|e| e.to_string())?;
@@ -434,6 +462,28 @@ pub fn capture_standalone(
     until_motion: bool,
     max_wait: Duration,
 ) -> Result<Capture, String> {
+    capture_standalone_after_clicks(
+        standalone,
+        display,
+        model,
+        audition,
+        until_motion,
+        max_wait,
+        &[],
+    )
+}
+
+/// [`capture_standalone`], clicking at each of `clicks` (window coordinates, in order, half a
+/// second apart) once the capture would have been taken, and capturing two seconds later.
+pub fn capture_standalone_after_clicks(
+    standalone: &Path,
+    display: &str,
+    model: &str,
+    audition: bool,
+    until_motion: bool,
+    max_wait: Duration,
+    clicks: &[(i16, i16)],
+) -> Result<Capture, String> {
     let log = std::env::temp_dir().join(format!(
         "ressort-standalone-{}-{}.log",
         std::process::id(),
@@ -499,6 +549,19 @@ pub fn capture_standalone(
                 plot_seen.is_some_and(|t| t.elapsed() >= SETTLE)
             };
             if done || shown.elapsed() >= max_wait {
+                if !clicks.is_empty() {
+                    for &(x, y) in clicks {
+                        click(display, window, x, y)?;
+                        std::thread::sleep(Duration::from_millis(500));
+                    }
+                    std::thread::sleep(SETTLE);
+                    let image = capture(display, window)?;
+                    return Ok(Capture {
+                        stats: plot_stats(&image),
+                        image,
+                        after_s: started.elapsed().as_secs_f64(),
+                    });
+                }
                 return Ok(Capture {
                     image,
                     stats,

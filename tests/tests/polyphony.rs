@@ -166,3 +166,82 @@ fn the_voices_setting_survives_the_state_and_follows_the_host() {
         "the host's new Voices setting must take effect at once"
     );
 }
+
+/// MPE through the host: with the MPE switch on, MIDI channel 1 is the master channel and
+/// channels 2 … 16 carry one note each with a ±48-semitone bend. A bend on one member channel
+/// moves only the voice of that channel: measured by FFT.
+#[test]
+fn an_mpe_bend_moves_only_its_channels_voice() {
+    use ressort_tests::{cents, peak_frequency};
+    let frames = 48_000;
+    let mut plugin = plugin_with_model(
+        "poly",
+        DAMPED_SLOWLY,
+        &[
+            ("voices", json!({ "i32": 8 })),
+            ("output_gain", json!({ "f32": -12.0 })),
+            ("mpe", json!({ "bool": true })),
+        ],
+    );
+    // CLAP channels count from 0: 1 and 2 are the MIDI member channels 2 and 3. The bend
+    // (+12 semitones: a quarter of the ±48 range) comes before its note, as MPE controllers
+    // send it.
+    let score = Score::new()
+        .note_on_channel(0, 60, 0.9, 1)
+        .pitch_bend_channel(0, 0.25, 2)
+        .note_on_channel(0, 67, 0.9, 2);
+    let bent = render(&mut plugin, frames, &score);
+    let alone = |key: u8, plugin: &mut TestPlugin| {
+        render(
+            plugin,
+            frames,
+            &Score::new().note_on_channel(0, key, 0.9, 1),
+        )
+        .left
+    };
+    let f60 = peak_frequency(&alone(60, &mut plugin), SR, 20.0, 20_000.0);
+    let f67 = peak_frequency(&alone(67, &mut plugin), SR, 20.0, 20_000.0);
+    let f79 = peak_frequency(&alone(79, &mut plugin), SR, 20.0, 20_000.0);
+    // The bent voice sounds at note 79, the other one stays at 60, nothing is left at 67.
+    let near = |f: f64| peak_frequency(&bent.left, SR, f / 1.03, f * 1.03);
+    let (low, high) = (near(f60), near(f79));
+    println!(
+        "alone: 60 → {f60:.2} Hz, 67 → {f67:.2} Hz, 79 → {f79:.2} Hz; bent chord peaks \
+         {low:.2} Hz ({:+.2} ct) and {high:.2} Hz ({:+.2} ct)",
+        cents(low, f60),
+        cents(high, f79)
+    );
+    assert!(cents(low, f60).abs() < 2.0, "channel 2's voice moved");
+    assert!(
+        cents(high, f79).abs() < 2.0,
+        "the bend did not reach channel 3's voice"
+    );
+    let share = ressort_tests::band_energy_share(&bent.left, SR, f67 / 1.01, f67 * 1.01);
+    println!("energy share at note 67: {share:.2e}");
+    assert!(share < 1e-3, "the unbent note 67 still sounds: {share:.2e}");
+
+    // Off, the same bend on channel 3 moves the whole instrument (by the Bend Range).
+    let mut plain = plugin_with_model(
+        "poly",
+        DAMPED_SLOWLY,
+        &[
+            ("voices", json!({ "i32": 8 })),
+            ("output_gain", json!({ "f32": -12.0 })),
+        ],
+    );
+    let global = render(&mut plain, frames, &score);
+    let moved = peak_frequency(&global.left, SR, f60 / 1.03, f60 * 1.03);
+    println!(
+        "MPE off: the voice of note 60 at {moved:.2} Hz ({:+.1} ct)",
+        cents(moved, f60)
+    );
+    assert!(cents(moved, f60) > 40.0, "without MPE a bend is global");
+}
+
+/// A lightly damped oscillator struck directly: one clean partial per voice.
+const DAMPED_SLOWLY: &str = "\
+# A lightly damped oscillator (MPE tests).
+@o osc 1. 0.02 0.0002 0. 0.
+@in1 frcInput @o
+@out1 posOutput @o
+";

@@ -20,6 +20,7 @@
 //! whose controls differ from the previous one's) and notes start a chunk at their own
 //! sample. Nothing here allocates, locks or does I/O after [`Instrument::new`].
 
+pub mod analysis;
 pub mod controls;
 pub mod dsp;
 pub mod envelope;
@@ -31,6 +32,7 @@ pub mod prepare;
 pub mod units;
 pub mod voices;
 
+pub use analysis::{ModalModel, ModesAtControls};
 pub use controls::{Controls, Gains};
 pub use envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
 pub use events::{Event, Timed};

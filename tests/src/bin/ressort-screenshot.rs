@@ -3,7 +3,11 @@
 //!
 //! ```text
 //! ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest]
+//!                    [--click X,Y]...
 //! ```
+//!
+//! Each `--click X,Y` clicks the editor at those window coordinates (in order) once the
+//! capture would have been taken; the capture follows two seconds later.
 //!
 //! By default the model is struck every second (`--audition`) and the capture is taken as soon
 //! as the motion view shows motion (within S seconds of the window appearing, default 20);
@@ -15,7 +19,7 @@
 //! `main` so their guards drop, and the kernel stops them if it is killed (see
 //! `screen::ChildGuard`).
 
-use ressort_tests::screen::{capture_standalone, shows_motion, standalone_path, Xvfb};
+use ressort_tests::screen::{capture_standalone_after_clicks, shows_motion, standalone_path, Xvfb};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -24,7 +28,7 @@ fn main() -> ExitCode {
     ExitCode::from(run())
 }
 
-const USAGE: &str = "usage: ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest]";
+const USAGE: &str = "usage: ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest] [--click X,Y]...";
 
 fn run() -> u8 {
     let mut model = "mesh-25x20".to_string();
@@ -32,6 +36,7 @@ fn run() -> u8 {
     let mut standalone = standalone_path();
     let mut seconds = 20.0;
     let mut at_rest = false;
+    let mut clicks: Vec<(i16, i16)> = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         if a == "--at-rest" {
@@ -40,7 +45,7 @@ fn run() -> u8 {
         }
         if !matches!(
             a.as_str(),
-            "--model" | "--out" | "--standalone" | "--seconds"
+            "--model" | "--out" | "--standalone" | "--seconds" | "--click"
         ) {
             eprintln!("{USAGE}");
             return 2;
@@ -53,6 +58,16 @@ fn run() -> u8 {
             "--model" => model = value,
             "--out" => out = Some(PathBuf::from(value)),
             "--standalone" => standalone = PathBuf::from(value),
+            "--click" => match value
+                .split_once(',')
+                .and_then(|(x, y)| Some((x.trim().parse().ok()?, y.trim().parse().ok()?)))
+            {
+                Some(xy) => clicks.push(xy),
+                None => {
+                    eprintln!("ressort-screenshot: --click takes X,Y (window pixels)");
+                    return 2;
+                }
+            },
             _ => match value.parse() {
                 Ok(s) => seconds = s,
                 Err(_) => {
@@ -73,13 +88,14 @@ fn run() -> u8 {
         eprintln!("ressort-screenshot: Xvfb could not be started (is the xvfb package installed?)");
         return 2;
     };
-    let capture = match capture_standalone(
+    let capture = match capture_standalone_after_clicks(
         &standalone,
         x.display(),
         &model,
         !at_rest,
         !at_rest,
         Duration::from_secs_f64(seconds),
+        &clicks,
     ) {
         Ok(c) => c,
         Err(e) => {
