@@ -403,3 +403,32 @@ fn tuning_by_maths_examples_are_real() {
     }
     assert!(checked >= 2);
 }
+
+/// docs/LANGUAGE.md §18 shows `ressort modes` on the 15 × 15 mesh preset: the command prints
+/// what the guide says (the gains of a repeated pair split by the solver's basis, so only
+/// their frequencies and decays are compared).
+#[test]
+fn the_guides_modes_table_is_what_the_command_prints() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let guide = std::fs::read_to_string(root.join("docs/LANGUAGE.md")).unwrap();
+    let command = "ressort modes models/mesh-15x15.mdl --count 8\n```\n\n```text\n";
+    let start = guide.find(command).expect("the example in §18") + command.len();
+    let shown = &guide[start..start + guide[start..].find("```").unwrap()];
+    let out = Command::new(env!("CARGO_BIN_EXE_ressort"))
+        .current_dir(&root)
+        .args(["modes", "models/mesh-15x15.mdl", "--count", "8"])
+        .output()
+        .expect("run ressort");
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let printed = text(&out.stdout);
+    assert_eq!(printed.lines().count(), shown.lines().count(), "{printed}");
+    for (p, s) in printed.lines().zip(shown.lines()) {
+        let paired = s.trim_start().starts_with("3 ") || s.trim_start().starts_with("4 ");
+        if paired {
+            let fields = |l: &str| l.split_whitespace().take(5).collect::<Vec<_>>().join(" ");
+            assert_eq!(fields(p), fields(s));
+        } else {
+            assert_eq!(p, s);
+        }
+    }
+}
