@@ -423,7 +423,10 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
             for c in 0..out_channels {
                 let v = out_buf[c * len + n];
                 peak = peak.max(v.abs());
-                writer.write_sample(v as f32).map_err(io)?;
+                // f32 has no room below 1.2e-38: tiny samples are written as 0, not subnormal.
+                writer
+                    .write_sample(ressort_engine::instrument::dsp::output_sample(v))
+                    .map_err(io)?;
             }
         }
         done += len as u64;

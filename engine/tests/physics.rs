@@ -224,3 +224,52 @@ fn oscillator_pitch_across_sample_rates_follows_the_exact_law() {
         assert!(cents(*f, pitches[0]).abs() < 0.1);
     }
 }
+
+/// Issue 11, denormals: a decaying model never reaches the subnormal range. Its tail ends in
+/// exact zeros (the state is flushed below 10⁻¹⁵⁰ every 64 samples), no output sample is
+/// subnormal, and the flush does not depend on the block size.
+#[test]
+fn a_decaying_tail_ends_in_zeros_not_subnormals() {
+    // Two coupled oscillators that lose about 10⁻³ of their amplitude per sample.
+    let text = "@g ground 0.\n@m mass 1. 0. 0.\n@s springDamper @g @m 0.05 0.004\n\
+                @m2 mass 1. 0. 0.\n@s2 springDamper @m2 @g 0.03 0.004\n\
+                @c spring @m @m2 0.01\n\
+                @in1 frcInput @m\n@out1 posOutput @m2\n@out2 frcOutput @m\n";
+    let spec = ressort_engine::parse(text).spec.expect("parses");
+    let frames = 600_000;
+    let mut e = engine(&spec, 44_100.0);
+    let out = render(&mut e, frames, 333, &[impulse(1.0, frames)]);
+    let subnormal = out.iter().flatten().filter(|v| v.is_subnormal()).count();
+    assert_eq!(subnormal, 0, "subnormal output samples");
+    assert!(
+        out[0].iter().any(|v| v.abs() > 1e-3),
+        "the model was struck"
+    );
+    let tail = &out[0][frames - 1000..];
+    let loudest = tail.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(
+        tail.iter().all(|&v| v == 0.0),
+        "the tail is not exactly 0: {loudest:e}"
+    );
+    assert!(e.positions().iter().all(|&v| v == 0.0));
+    // Without the flush it would still ring around 10⁻¹⁰⁰ or below: find where it fell under
+    // the flush level, and check the flush is not what silenced it early.
+    let last_loud = out[0].iter().rposition(|v| v.abs() > 1e-140).unwrap();
+    assert!(last_loud > 10_000, "it decayed too early ({last_loud})");
+    println!("above 1e-140 until sample {last_loud}; the last 1000 samples are exactly 0");
+    // Block sizes 1 and 333 give the same samples.
+    let mut one = engine(&spec, 44_100.0);
+    let by_one = render(&mut one, frames, 1, &[impulse(1.0, frames)]);
+    assert!(by_one == out, "the flush depends on the block size");
+}
+
+/// A state that starts subnormal (a script's tiny initial position) is flushed at the reset.
+#[test]
+fn a_subnormal_initial_state_is_flushed_at_reset() {
+    let spec = ressort_engine::parse("@o osc 1. 0.01 0. 1e-310 0.\n@out1 posOutput @o\n")
+        .spec
+        .expect("parses");
+    let mut e = engine(&spec, 44_100.0);
+    let out = render(&mut e, 256, 256, &[]);
+    assert!(out[0].iter().all(|&v| v == 0.0), "{:?}", &out[0][..4]);
+}
