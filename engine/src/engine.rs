@@ -1029,7 +1029,7 @@ impl Engine {
                     break;
                 }
                 self.samples_since_reset += 1;
-                if self.samples_since_reset % FLUSH_INTERVAL == 0 {
+                if self.samples_since_reset.is_multiple_of(FLUSH_INTERVAL) {
                     self.flush_tiny();
                 }
             }

@@ -192,6 +192,31 @@ fn sparse_plate_at(sr: f64) {
     }
 }
 
+/// A model above the dense limit gets the modal reference pitch when it is prepared for the
+/// instrument (issue 14: "for models of any size"): a mode of the closed-form plate.
+#[test]
+fn a_large_model_is_prepared_with_its_modal_reference_pitch() {
+    let l = 42; // 1600 moving nodes: the sparse solver
+    let text = format!(
+        "@p closedMesh {l} {l} 1. 0.1 0. 0. 0.\n@in1 frcInput [@p 0.3 0.4]\n@out1 posOutput [@p 0.6 0.7]\n"
+    );
+    let sr = 44_100.0;
+    let prepared = ressort_engine::instrument::prepare("plate", &text, sr).expect("prepares");
+    let pitch = prepared
+        .settings
+        .reference_pitch_hz
+        .expect("a reference pitch");
+    let closed_form: Vec<f64> = plate_lambdas(l, 0.1)
+        .iter()
+        .map(|lambda| sr / PI * (lambda.sqrt() / 2.0).asin())
+        .collect();
+    assert!(
+        closed_form.iter().any(|f| rel(*f, pitch) < 1e-9),
+        "{pitch} Hz is not a mode of the plate"
+    );
+    assert!(pitch > 20.0);
+}
+
 /// Local maxima of the magnitude spectrum above `floor` × the largest, as (frequency, height):
 /// Hann window, zero-padded 8× so that a peak's height is read within 0.3 % of its top.
 fn spectral_peaks(signal: &[f64], sr: f64, floor: f64) -> Vec<(f64, f64)> {

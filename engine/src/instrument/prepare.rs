@@ -218,10 +218,11 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
 }
 
 /// The model's reference pitch (issue 14): the strongest mode that `@out1` hears from the note
-/// input, by the modal analysis ([`crate::modes`]) — dense and exact up to
-/// [`crate::modes::DENSE_LIMIT`] moving points. Larger models (and models the analysis cannot
-/// read, a note input with no linear path) fall back to the impulse response's strongest peak
-/// ([`estimate_pitch`]), within its work budget.
+/// input, by the modal analysis ([`crate::modes`]), for models of any size: dense and exact up
+/// to [`crate::modes::DENSE_LIMIT`] moving points, the strongest of the lowest
+/// [`crate::modes::DEFAULT_SPARSE_COUNT`] above (about 2 s for the 150 × 150 plate). Models the
+/// analysis cannot read (a note input with no linear path) fall back to the impulse
+/// response's strongest peak ([`estimate_pitch`]), within its work budget.
 fn reference_pitch(
     engine: &mut Engine,
     note_input: Option<usize>,
@@ -231,10 +232,8 @@ fn reference_pitch(
     if engine.info().num_outputs() == 0 {
         return None;
     }
-    if engine.info().num_points <= crate::modes::DENSE_LIMIT {
-        if let Some(f) = engine.reference_pitch(k + 1, 1).filter(|f| *f > 0.0) {
-            return Some(f);
-        }
+    if let Some(f) = engine.reference_pitch(k + 1, 1).filter(|f| *f > 0.0) {
+        return Some(f);
     }
     estimate_pitch(engine, note_input, roles)
 }
