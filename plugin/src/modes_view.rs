@@ -522,6 +522,7 @@ mod tests {
             radius: 0.9999,
             lambda: 0.01,
             gains: vec![1.0],
+            residues: vec![(0.0, 1.0)],
             shape: vec![0.0, 1.0, -0.5],
         }
     }

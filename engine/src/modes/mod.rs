@@ -23,8 +23,10 @@
 //!   [`COMPANION_LIMIT`] moving points; beyond that γ = ψᵀΓψ (spec §5.5 step 4), flagged by
 //!   [`ModalAnalysis::proportional`] = false.
 //! * **Large models** (more than [`DENSE_LIMIT`] moving points): the lowest modes by
-//!   shift-invert Lanczos on a sparse Cholesky factor of S − σI, with deflated restarts that
-//!   find every copy of a repeated eigenvalue (square plates have paired modes).
+//!   block shift-invert Lanczos on a sparse Cholesky factor of S − σI (`sparse.rs`), whose
+//!   blocks find every copy of a repeated eigenvalue (square plates have paired modes).
+//! * **Repeated eigenvalues** get one basis whatever the solver: the first copy is the shape
+//!   the first linear input excites (`solve.rs`, `canonical_eigenspaces`).
 //!
 //! **Modal gain.** The impulse response of output o to a unit impulse on input i is
 //! y[n] = Σ c·rⁿ over the eigenvalues; a mode's gain is the amplitude of its decaying
@@ -68,6 +70,11 @@ pub struct Mode {
     /// Modal gains, input-major: `gains[i * num_outputs + o]` from input channel i + 1 to
     /// output channel o + 1, in output units per unit input impulse.
     pub gains: Vec<f64>,
+    /// The complex residues behind the gains, in the same order, as (re, im) and scaled so
+    /// that `gains[k]` = |`residues[k]`|. The copies of a repeated mode (the pairs of square
+    /// plates) split the residue in a way that depends on the basis chosen in their
+    /// eigenspace; their sum does not.
+    pub residues: Vec<(f64, f64)>,
     /// The mode shape over [`crate::ModelInfo::points`] (0 on points that do not move),
     /// largest component 1.
     pub shape: Vec<f64>,
@@ -118,10 +125,22 @@ impl ModalAnalysis {
             .map_or(0.0, |m| m.gains[i * self.num_outputs + o])
     }
 
+    /// |Σ residue| over `modes` from `input` to `output` (1-based channels).
+    fn residue_sum(&self, modes: std::ops::Range<usize>, input: usize, output: usize) -> f64 {
+        let (i, o) = (input.wrapping_sub(1), output.wrapping_sub(1));
+        if i >= self.num_inputs || o >= self.num_outputs {
+            return 0.0;
+        }
+        let (re, im) = self.modes[modes]
+            .iter()
+            .map(|m| m.residues[i * self.num_outputs + o])
+            .fold((0.0, 0.0), |a, r| (a.0 + r.0, a.1 + r.1));
+        re.hypot(im)
+    }
+
     /// The strongest mode above `min_hz` from `input` to `output` (1-based channels). The
-    /// copies of a repeated mode (the pairs of square plates) split their gain in a way that
-    /// depends on the basis the solver chose, so they count together, by the sum of their
-    /// gains (a bound of their joint amplitude).
+    /// copies of a repeated mode count together, by the modulus of their summed residue: the
+    /// amplitude of the one sinusoid they make, whatever basis the solver chose.
     pub fn strongest(&self, input: usize, output: usize, min_hz: f64) -> Option<&Mode> {
         let mut best: Option<(usize, f64)> = None;
         let mut k = 0;
@@ -133,7 +152,7 @@ impl ModalAnalysis {
             {
                 end += 1;
             }
-            let total: f64 = (k..end).map(|j| self.gain(j, input, output)).sum();
+            let total = self.residue_sum(k..end, input, output);
             if f >= min_hz && total.is_finite() && best.is_none_or(|(_, g)| total > g) {
                 best = Some((k, total));
             }

@@ -50,6 +50,8 @@ pub(super) fn modes(
             None => return analysis,
         }
     };
+    let mut psi = psi;
+    canonical_eigenspaces(sys, &inv_sqrt_m, &lambdas, &mut psi);
     let m = lambdas.len();
     // γ_k = ψ_kᵀΓψ_k, and whether Γ is diagonal in the basis ψ (spec §5.5 step 4).
     let mut gammas = vec![0.0; m];
@@ -79,7 +81,14 @@ pub(super) fn modes(
             }
         }
     } else {
-        // Residual ‖Γψ − γψ‖ of each computed mode.
+        // Residual ‖Γψ − γψ‖ of each computed mode, against Γ's own scale: the vectors are
+        // S's eigenvectors to a residual relative to ‖S‖, not to the lowest modes' λ.
+        scale = gamma
+            .entries
+            .iter()
+            .filter(|e| e.0 == e.1)
+            .map(|e| e.2.abs())
+            .fold(scale, f64::max);
         for k in 0..m {
             let r: f64 = (0..n)
                 .map(|i| (projected[(i, k)] - gammas[k] * psi[(i, k)]).powi(2))
@@ -110,6 +119,57 @@ pub(super) fn modes(
     }
     finish(&mut analysis, count);
     analysis
+}
+
+/// Two eigenvalues closer than this, relative to the largest computed, are one repeated
+/// eigenvalue.
+const REPEATED: f64 = 1e-9;
+
+/// A repeated eigenvalue's vectors are any orthonormal basis of its eigenspace, and solvers
+/// pick one by rounding: the copies' shapes and gains would change with the sample rate or
+/// the solver. This picks one basis for every eigenspace: the first copy is the shape the
+/// first linear input excites (the eigenspace's projection of its force vector), the others
+/// are orthogonal to it, and so receive nothing from that input. The rotation is the
+/// Householder reflection H with H·e₁ = a/‖a‖, a = Ψᵀ·w, w = M^−½·b the input in S's
+/// coordinates.
+fn canonical_eigenspaces(sys: &System, inv_sqrt_m: &[f64], lambdas: &[f64], psi: &mut Mat<f64>) {
+    let Some(input) = sys.inputs.iter().find(|p| p.linear) else {
+        return;
+    };
+    let n = psi.nrows();
+    let w: Vec<f64> = (0..n)
+        .map(|i| (input.p[i] + input.q[i]) * inv_sqrt_m[i])
+        .collect();
+    let scale = lambdas.iter().fold(0.0f64, |a, l| a.max(l.abs()));
+    let mut k = 0;
+    while k < lambdas.len() {
+        let mut end = k + 1;
+        while end < lambdas.len() && (lambdas[end] - lambdas[k]).abs() <= REPEATED * scale {
+            end += 1;
+        }
+        let d = end - k;
+        if d > 1 {
+            let cols = psi.as_ref().subcols(k, d).to_owned();
+            let a: Vec<f64> = (0..d)
+                .map(|c| (0..n).map(|i| cols[(i, c)] * w[i]).sum())
+                .collect();
+            let norm = a.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm > 0.0 {
+                // v = â − e₁; H = I − 2·v·vᵀ/‖v‖².
+                let mut v: Vec<f64> = a.iter().map(|x| x / norm).collect();
+                v[0] -= 1.0;
+                let vv: f64 = v.iter().map(|x| x * x).sum();
+                if vv > 1e-30 {
+                    let h = Mat::<f64>::from_fn(d, d, |r, c| {
+                        f64::from(u8::from(r == c)) - 2.0 * v[r] * v[c] / vv
+                    });
+                    let rotated = &cols * &h;
+                    psi.as_mut().subcols_mut(k, d).copy_from(&rotated);
+                }
+            }
+        }
+        k = end;
+    }
 }
 
 /// Sorts by frequency and keeps the lowest `count`.
@@ -186,18 +246,18 @@ fn proportional_mode(
     let radius = if complex { b.max(0.0).sqrt() } else { r.norm() };
     let (frequency_hz, t60_s) = frequency_and_t60(r, radius, sample_rate);
     let denom = r - r2;
-    let mut gains = Vec::with_capacity(sys.inputs.len() * sys.outputs.len());
+    let mut residues = Vec::with_capacity(sys.inputs.len() * sys.outputs.len());
     for input in &sys.inputs {
         let beta = port_at(input, phi, r);
         for output in &sys.outputs {
             let alpha = port_at(output, phi, r);
-            let g = if denom.norm() > 1e-300 {
-                (alpha * beta / denom).norm() * if complex { 2.0 } else { 1.0 }
+            let c = if denom.norm() > 1e-300 {
+                alpha * beta / denom * if complex { 2.0 } else { 1.0 }
             } else {
                 // A double root (a free body, r = 1): the response grows linearly.
-                (alpha * beta).norm()
+                alpha * beta
             };
-            gains.push(g);
+            residues.push((c.re, c.im));
         }
     }
     Mode {
@@ -205,7 +265,8 @@ fn proportional_mode(
         t60_s,
         radius,
         lambda,
-        gains,
+        gains: residues.iter().map(|c| c.0.hypot(c.1)).collect(),
+        residues,
         shape: shape_over_points(sys, num_points, |i| phi[i]),
     }
 }
@@ -250,7 +311,7 @@ fn companion_modes(sys: &System, num_points: usize, sample_rate: f64) -> Option<
         }
         let (frequency_hz, t60_s) = frequency_and_t60(r, r.norm(), sample_rate);
         let vel = one - r.inv();
-        let mut gains = Vec::with_capacity(ni * sys.outputs.len());
+        let mut residues = Vec::with_capacity(ni * sys.outputs.len());
         for c in 0..ni {
             let beta = wb[(m, 2 * c)] + wb[(m, 2 * c + 1)] * vel;
             for output in &sys.outputs {
@@ -259,7 +320,8 @@ fn companion_modes(sys: &System, num_points: usize, sample_rate: f64) -> Option<
                 for i in 0..n {
                     alpha += v[(i, m)] * (output.p[i] + output.q[i]) - v[(n + i, m)] * output.q[i];
                 }
-                gains.push(2.0 * (alpha * beta / r).norm());
+                let c = alpha * beta / r * 2.0;
+                residues.push((c.re, c.im));
             }
         }
         // The real part of the shape after rotating its largest component onto the real axis.
@@ -279,7 +341,8 @@ fn companion_modes(sys: &System, num_points: usize, sample_rate: f64) -> Option<
             t60_s,
             radius,
             lambda: 2.0 - gamma - 2.0 * r.re,
-            gains,
+            gains: residues.iter().map(|c| c.0.hypot(c.1)).collect(),
+            residues,
             shape: shape_over_points(sys, num_points, |i| (v[(i, m)] * rot).re),
         });
     }

@@ -1,186 +1,215 @@
 //! The lowest eigenpairs of a large sparse symmetric S (spec §5.5 for models too large for a
-//! dense eigendecomposition): shift-invert Lanczos. S − σI (σ slightly below 0, so free
-//! structures with λ = 0 stay factorable) is factored once by sparse Cholesky; the eigenvalues
-//! θ of (S − σI)⁻¹ with the largest magnitude are the λ = σ + 1/θ nearest σ, the lowest.
+//! dense eigendecomposition): block shift-invert Lanczos with full reorthogonalisation.
 //!
-//! A Krylov method started from one vector sees one copy of a repeated eigenvalue in exact
-//! arithmetic (square plates have paired modes, f(k₁, k₂) = f(k₂, k₁)), and in floating point
-//! may also return spurious copies of a converged one. So the solver runs twice, in parallel,
-//! from different start vectors, each finding its own vector of every repeated eigenspace, and
-//! merges the runs by Rayleigh–Ritz on the union of their vectors, keeping the pairs whose
-//! residual has converged. Two runs find both copies of the pairs of square plates; three-fold
-//! or higher multiplicities would need more.
+//! S − σI (σ slightly below 0, so free structures with λ = 0 stay factorable) is factored once
+//! by sparse Cholesky. The operator A = (S − σI)⁻¹ has eigenvalues θ = 1/(λ − σ): the lowest λ
+//! are the largest θ, well separated from the bulk that crowds near 0, which is where Lanczos
+//! converges first. With Q the orthonormal Krylov basis built block by block,
+//!
+//! ```text
+//!   A·Q_j = Q_{j−1}·R_{j−1}ᵀ + Q_j·T_j + Q_{j+1}·R_j       (block three-term recurrence)
+//!   T = Qᵀ·A·Q,   Ritz pairs (θ, Q·y) from T·y = θ·y,   residual ‖R_last·y_last‖
+//! ```
+//!
+//! Three choices make it robust where a library's single-vector restarted Lanczos was not:
+//! - **Blocks of [`BLOCK`] vectors.** A Krylov method started from one vector sees one copy of a
+//!   repeated eigenvalue; square plates have exactly paired modes, f(k₁, k₂) = f(k₂, k₁). A
+//!   block of b vectors sees every copy of an eigenvalue up to multiplicity b.
+//! - **Full reorthogonalisation** (classical Gram–Schmidt, twice) against the whole basis, so
+//!   that rounding never makes ghost copies of a converged pair and T is Qᵀ·A·Q to rounding.
+//! - **A relative convergence test**, residual ≤ [`TOLERANCE`]·θ. The per-step K and M of a
+//!   model scale with the sample rate, so θ does; an absolute test converges at one rate and
+//!   crawls at another.
 
 use super::system::SymSparse;
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::solvers::Solve;
-use faer::matrix_free::eigen::{
-    partial_self_adjoint_eigen, partial_self_adjoint_eigen_scratch, PartialEigenParams,
-};
-use faer::matrix_free::LinOp;
-use faer::reborrow::ReborrowMut;
 use faer::sparse::linalg::solvers::Llt;
-use faer::{Mat, MatMut, MatRef, Par, Side};
+use faer::{Accum, Mat, MatMut, Par, Side};
 
-/// Lanczos runs from different start vectors: two find both copies of every pair.
-const RUNS: usize = 2;
-/// The Krylov solver's convergence tolerance.
-const LANCZOS_TOLERANCE: f64 = f64::EPSILON * 128.0;
-/// Extra eigenpairs asked of each run, so that the last wanted ones converge.
-const GUARD: usize = 10;
+/// Vectors per Lanczos block: every copy of an eigenvalue up to this multiplicity is found.
+const BLOCK: usize = 4;
+/// A Ritz pair (θ, x) has converged when ‖A·x − θ·x‖ ≤ TOLERANCE·θ.
+const TOLERANCE: f64 = 1e-11;
+/// Extra pairs that must converge beyond those asked for, so that the last wanted ones are
+/// not mistaken for a cluster's first.
+const GUARD: usize = 4;
+/// The basis grows to at most this many times the pairs asked for (plus a floor).
+const MAX_BASIS_FACTOR: usize = 6;
+const MAX_BASIS_FLOOR: usize = 120;
+/// Basis columns added between two Rayleigh–Ritz checks.
+const CHECK_EVERY: usize = 16;
+/// A new column keeping less than this fraction of its norm through the orthogonalisation
+/// is in the span already (an invariant subspace was found): a fresh start vector replaces it.
+const BREAKDOWN: f64 = 1e-9;
 
-/// x ↦ (S − σI)⁻¹·x by the sparse Cholesky factor.
-#[derive(Debug)]
-struct ShiftInvert<'a> {
-    llt: &'a Llt<u32, f64>,
-    n: usize,
+/// A deterministic start vector, every component non-zero, different for every `seed`.
+fn start_vector(seed: usize) -> impl Fn(usize) -> f64 {
+    let a = 0.754_877_666_246_692_7 * (seed + 1) as f64;
+    move |i| 1.0 + 0.5 * ((i as f64 + 1.0) * a).sin() + 0.25 * ((i as f64 + 3.0) * a * 1.7).cos()
 }
 
-impl LinOp<f64> for ShiftInvert<'_> {
-    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
-        StackReq::EMPTY
+/// w ← w − Q·(Qᵀ·w), twice; returns the coefficients of both passes, summed (m × cols).
+fn project_out(q: faer::MatRef<'_, f64>, mut w: MatMut<'_, f64>) -> Mat<f64> {
+    let mut total = Mat::<f64>::zeros(q.ncols(), w.ncols());
+    if q.ncols() == 0 {
+        return total;
     }
-    fn nrows(&self) -> usize {
-        self.n
+    for _ in 0..2 {
+        let c = q.transpose() * w.as_ref();
+        faer::linalg::matmul::matmul(w.as_mut(), Accum::Add, q, c.as_ref(), -1.0, Par::Seq);
+        total += &c;
     }
-    fn ncols(&self) -> usize {
-        self.n
-    }
-    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _s: &mut MemStack) {
-        out.copy_from(rhs);
-        self.llt.solve_in_place(out.rb_mut());
-    }
-    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, s: &mut MemStack) {
-        self.apply(out, rhs, par, s);
-    }
+    total
 }
 
-/// One Lanczos run: the eigenpairs (θ, vector) it converged, largest θ first.
-fn run(op: &ShiftInvert<'_>, want: usize, seed: f64) -> Vec<(f64, Vec<f64>)> {
-    let n = op.nrows();
-    let want = want.min(n);
-    let par = Par::Seq;
-    let params = PartialEigenParams::default();
-    let mut mem = MemBuffer::new(partial_self_adjoint_eigen_scratch(op, want, par, params));
-    // A deterministic start with every component non-zero, different for every seed.
-    let mut v0 = Mat::<f64>::from_fn(n, 1, |i, _| 1.0 + 0.5 * ((i as f64 + 1.0) * seed).sin());
-    let norm = v0.norm_l2();
-    if !(norm > 0.0) {
-        return Vec::new();
-    }
-    v0 /= faer::Scale(norm);
-    let mut vecs = Mat::<f64>::zeros(n, want);
-    let mut vals = vec![0.0; want];
-    let info = partial_self_adjoint_eigen(
-        vecs.as_mut(),
-        &mut vals,
-        op,
-        v0.col(0),
-        LANCZOS_TOLERANCE,
-        par,
-        MemStack::new(&mut mem),
-        params,
-    );
-    (0..info.n_converged_eigen)
-        .filter(|&k| vals[k] > 0.0)
-        .map(|k| (vals[k], (0..n).map(|i| vecs[(i, k)]).collect()))
-        .collect()
-}
-
-/// Orthonormal columns spanning the vectors (modified Gram–Schmidt, twice), dropping the
-/// ones already in the span (a Krylov solver's spurious copies of a converged vector).
-fn orthonormalise(vectors: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
-    let mut cols: Vec<Vec<f64>> = Vec::with_capacity(vectors.len());
-    for mut v in vectors {
-        let start = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        for _ in 0..2 {
-            for c in &cols {
-                let d: f64 = c.iter().zip(&v).map(|(a, b)| a * b).sum();
-                for (x, y) in v.iter_mut().zip(c) {
-                    *x -= d * y;
-                }
+/// Appends the columns of `w` (already orthogonal to the basis) to the basis, orthonormalising
+/// them among themselves (modified Gram–Schmidt). Returns R with w = Q_new·R (R upper
+/// triangular; a column in the span already gets a zero row and a fresh start vector).
+fn append_block(q: &mut Mat<f64>, m: &mut usize, mut w: Mat<f64>, seed: &mut usize) -> Mat<f64> {
+    let (n, b) = (w.nrows(), w.ncols());
+    let mut r = Mat::<f64>::zeros(b, b);
+    let first = *m;
+    for c in 0..b {
+        if *m >= n {
+            break;
+        }
+        let before = w.col(c).norm_l2();
+        for p in first..*m {
+            let d = q.col(p).transpose() * w.col(c);
+            r[(p - first, c)] += d;
+            let qp = q.col(p).to_owned();
+            w.col_mut(c)
+                .iter_mut()
+                .zip(qp.iter())
+                .for_each(|(x, y)| *x -= d * y);
+        }
+        let mut norm = w.col(c).norm_l2();
+        let mut v = w.col(c).to_owned();
+        if !(norm > BREAKDOWN * before.max(f64::MIN_POSITIVE)) {
+            // Deflation: continue from a fresh direction orthogonal to the whole basis.
+            *seed += 1;
+            let f = start_vector(*seed);
+            let mut fresh = Mat::<f64>::from_fn(n, 1, |i, _| f(i));
+            project_out(q.as_ref().subcols(0, *m), fresh.as_mut());
+            v = fresh.col(0).to_owned();
+            norm = v.norm_l2();
+            if !(norm > 0.0) {
+                break;
             }
+        } else {
+            r[(*m - first, c)] = norm;
         }
-        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if norm > 1e-6 * start {
-            v.iter_mut().for_each(|x| *x /= norm);
-            cols.push(v);
-        }
+        let inv = 1.0 / norm;
+        q.col_mut(*m)
+            .iter_mut()
+            .zip(v.iter())
+            .for_each(|(x, y)| *x = y * inv);
+        *m += 1;
     }
-    cols
-}
-
-/// The Ritz pairs of S on an orthonormal basis Q (eigenpairs of QᵀSQ), ascending, keeping
-/// those whose residual ‖Sq − λq‖ is below `tolerance`: the converged eigenpairs.
-fn rayleigh_ritz(s: &SymSparse, basis: Vec<Vec<f64>>, tolerance: f64) -> (Vec<Vec<f64>>, Vec<f64>) {
-    let (n, m) = (s.n, basis.len());
-    if m == 0 {
-        return (basis, Vec::new());
-    }
-    let q = Mat::<f64>::from_fn(n, m, |i, j| basis[j][i]);
-    let mut sq = Mat::<f64>::zeros(n, m);
-    let mut y = vec![0.0; n];
-    for (j, v) in basis.iter().enumerate() {
-        s.mul(v, &mut y);
-        for i in 0..n {
-            sq[(i, j)] = y[i];
-        }
-    }
-    let h = q.transpose() * &sq;
-    let h = Mat::<f64>::from_fn(m, m, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
-    let Ok(evd) = h.self_adjoint_eigen(Side::Lower) else {
-        return (Vec::new(), Vec::new());
-    };
-    let ritz = &q * evd.U();
-    let s_ritz = &sq * evd.U();
-    let mut vecs = Vec::new();
-    let mut vals = Vec::new();
-    for k in 0..m {
-        let lambda = evd.S().column_vector()[k];
-        let residual = (0..n)
-            .map(|i| (s_ritz[(i, k)] - lambda * ritz[(i, k)]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        if residual <= tolerance {
-            vecs.push((0..n).map(|i| ritz[(i, k)]).collect());
-            vals.push(lambda);
-        }
-    }
-    (vecs, vals)
+    r
 }
 
 /// The `want` lowest eigenvalues of S (ascending) and their orthonormal vectors (columns).
 pub(super) fn lowest_eigenpairs(s: &SymSparse, want: usize) -> Option<(Vec<f64>, Mat<f64>)> {
     let n = s.n;
+    let want = want.min(n);
+    if want == 0 {
+        return Some((Vec::new(), Mat::zeros(n, 0)));
+    }
     let max_diag = s
         .entries
         .iter()
         .filter(|e| e.0 == e.1)
         .map(|e| e.2.abs())
-        .fold(0.0, f64::max);
-    let sigma = -1e-6 * max_diag.max(f64::MIN_POSITIVE);
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let sigma = -1e-6 * max_diag;
     let shifted = SymSparse::combine(1.0, s, 0.0, s, &vec![-sigma; n]);
-    let llt = shifted.lower()?.sp_cholesky(Side::Lower).ok()?;
-    let ask = (want + GUARD).min(n);
-    let tolerance = 1e-9 * max_diag.max(f64::MIN_POSITIVE);
-    // The runs are independent: each on its own thread (the factor is shared read-only).
-    let op = ShiftInvert { llt: &llt, n };
-    let runs: Vec<Vec<(f64, Vec<f64>)>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..RUNS)
-            .map(|k| {
-                let op = &op;
-                scope.spawn(move || run(op, ask, 0.7548776662466927 * (k + 1) as f64))
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().unwrap_or_default())
-            .collect()
-    });
-    let candidates: Vec<Vec<f64>> = runs.into_iter().flatten().map(|(_, v)| v).collect();
-    let (mut basis, mut lambdas) = rayleigh_ritz(s, orthonormalise(candidates), tolerance);
-    basis.truncate(want);
-    lambdas.truncate(want);
-    let vectors = Mat::<f64>::from_fn(n, basis.len(), |i, j| basis[j][i]);
-    Some((lambdas, vectors))
+    let llt: Llt<u32, f64> = shifted.lower()?.sp_cholesky(Side::Lower).ok()?;
+
+    let need = (want + GUARD).min(n);
+    let limit = n.min(MAX_BASIS_FACTOR * need + MAX_BASIS_FLOOR);
+    let b = BLOCK.min(n);
+    // Room for the block beyond the last one expanded, whose R gives the residuals.
+    let cap = n.min(limit + 2 * b);
+    let mut q = Mat::<f64>::zeros(n, cap);
+    // h[.., j] = Qᵀ·A·q_j, with the next block's R below the diagonal block.
+    let mut h = Mat::<f64>::zeros(cap, cap);
+    let mut m = 0;
+    let mut seed = b;
+    let start = Mat::<f64>::from_fn(n, b, |i, c| start_vector(c)(i));
+    append_block(&mut q, &mut m, start, &mut seed);
+
+    let mut j0 = 0; // the first column of the block to expand
+    let mut checked = 0;
+    while j0 < m && j0 < limit {
+        let j1 = m;
+        // W = A·Q_j by the Cholesky factor, orthogonalised against the whole basis.
+        let mut w = q.as_ref().subcols(j0, j1 - j0).to_owned();
+        llt.solve_in_place(w.as_mut());
+        let c = project_out(q.as_ref().subcols(0, m), w.as_mut());
+        h.as_mut().submatrix_mut(0, j0, m, j1 - j0).copy_from(&c);
+        let r = append_block(&mut q, &mut m, w, &mut seed);
+        let added = m - j1;
+        h.as_mut()
+            .submatrix_mut(j1, j0, added, j1 - j0)
+            .copy_from(r.as_ref().subrows(0, added));
+        j0 = j1;
+        let last = j0 >= m || j0 >= limit;
+        if j0 < need || (j0 - checked < CHECK_EVERY && !last) {
+            continue;
+        }
+        // Rayleigh–Ritz on the expanded columns 0..j0.
+        checked = j0;
+        let t = Mat::<f64>::from_fn(j0, j0, |a, c| 0.5 * (h[(a, c)] + h[(c, a)]));
+        let evd = t.self_adjoint_eigen(Side::Lower).ok()?;
+        let theta = evd.S().column_vector();
+        let y = evd.U();
+        // A Ritz pair's residual is its coupling to the columns not yet expanded.
+        let tail = h.as_ref().submatrix(j0, 0, m - j0, j0);
+        let converged = (0..j0)
+            .rev()
+            .take(need)
+            .take_while(|&k| (tail * y.col(k)).norm_l2() <= TOLERANCE * theta[k].abs())
+            .count();
+        if converged >= need || last {
+            // Largest θ first: the lowest λ = σ + 1/θ, ascending.
+            let pick: Vec<usize> = (0..j0).rev().take(converged.min(want)).collect();
+            let sel = Mat::<f64>::from_fn(j0, pick.len(), |a, c| y[(a, pick[c])]);
+            let vectors = q.as_ref().subcols(0, j0) * &sel;
+            let lambdas: Vec<f64> = pick.iter().map(|&k| sigma + 1.0 / theta[k]).collect();
+            return Some(verified(s, lambdas, vectors, 1e-9 * max_diag));
+        }
+    }
+    None
+}
+
+/// The pairs that hold in S itself: ‖S·x − λ·x‖ ≤ `tolerance`.
+fn verified(
+    s: &SymSparse,
+    lambdas: Vec<f64>,
+    vectors: Mat<f64>,
+    tolerance: f64,
+) -> (Vec<f64>, Mat<f64>) {
+    let n = s.n;
+    let mut x = vec![0.0; n];
+    let mut sx = vec![0.0; n];
+    let mut keep = Vec::new();
+    for (k, &lambda) in lambdas.iter().enumerate() {
+        x.iter_mut()
+            .zip(vectors.col(k).iter())
+            .for_each(|(a, b)| *a = *b);
+        s.mul(&x, &mut sx);
+        let res = sx
+            .iter()
+            .zip(&x)
+            .map(|(a, b)| (a - lambda * b).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        if res <= tolerance {
+            keep.push(k);
+        }
+    }
+    let out = Mat::<f64>::from_fn(n, keep.len(), |i, c| vectors[(i, keep[c])]);
+    (keep.iter().map(|&k| lambdas[k]).collect(), out)
 }
