@@ -160,6 +160,23 @@ fn square_plate_dense_multiplicities() {
     first_copy_takes_the_input(&a);
 }
 
+/// The companion matrix's repeated roots get the same basis: a square plate with a damper at
+/// its centre, which keeps the square's symmetry (so its pairs) and makes the damping
+/// non-proportional.
+#[test]
+fn companion_pairs_give_the_input_to_their_first_copy() {
+    let mut e = engine(
+        &spec(
+            "@p closedMesh 15 15 1. 0.1 0.0001 0. 0.\n@g ground 0.\n@d damper [@p 0.5 0.5] @g 0.02\n\
+             @in1 frcInput [@p 0.3 0.4]\n@out1 posOutput [@p 0.6 0.7]\n",
+        ),
+        44_100.0,
+    );
+    let a = e.modes(None);
+    assert_eq!(a.solver, Solver::Companion);
+    first_copy_takes_the_input(&a);
+}
+
 /// The copies of every repeated mode in the basis the analysis picks: the first takes all the
 /// gain from `@in1`, the others none, so gains and shapes do not depend on the solver's
 /// rounding (both solvers, every sample rate).
@@ -339,6 +356,85 @@ fn impulse_response_peaks_sit_on_modes() {
         );
         assert!(rel(measured, computed) < 0.03, "{measured} vs {computed}");
     }
+}
+
+/// The impulse response the modes predict, y[n] = Σ Re(c·rⁿ) over the listed modes (c the
+/// residue, r the root), aligned on the rendered one: the best of the first few offsets.
+/// Returns the largest difference relative to the largest sample.
+fn modal_response_error(e: &mut Engine, a: &ressort_engine::modes::ModalAnalysis, n: usize) -> f64 {
+    let y = &render(e, n + 4, 64, &[impulse(1.0, n + 4)])[0];
+    let sr = a.sample_rate_hz;
+    let predicted: Vec<f64> = (0..n)
+        .map(|t| {
+            a.modes
+                .iter()
+                .map(|m| {
+                    let (re, im) = m.residues[0];
+                    let phase = 2.0 * PI * m.frequency_hz / sr * t as f64;
+                    let mag = m.radius.powi(t as i32);
+                    mag * (re * phase.cos() - im * phase.sin())
+                })
+                .sum()
+        })
+        .collect();
+    let peak = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    (0..4)
+        .map(|off| {
+            (1..n)
+                .map(|t| (y[t + off] - predicted[t]).abs())
+                .fold(0.0f64, f64::max)
+                / peak
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The residues rebuild the rendered impulse response sample by sample: the proportional
+/// path (a string, a square plate with pairs) and the companion matrix (two masses, and a
+/// plate damped at its centre, with pairs and a 6-fold root).
+#[test]
+fn residues_rebuild_the_impulse_response() {
+    let mut string = engine(
+        &spec("@s string 26 1. 0.4 0.0002 0. 0.\n@in1 frcInput [@s 0.23]\n@out1 posOutput [@s 0.61]\n"),
+        44_100.0,
+    );
+    let a = string.modes(None);
+    assert_eq!(a.solver, Solver::Dense);
+    let err = modal_response_error(&mut string, &a, 3000);
+    eprintln!("string: {err:.2e}");
+    assert!(err < 1e-9, "string: {err}");
+    let mut square = engine(
+        &spec("@p closedMesh 9 9 1. 0.1 0.0001 0. 0.\n@in1 frcInput [@p 0.3 0.4]\n@out1 posOutput [@p 0.6 0.7]\n"),
+        44_100.0,
+    );
+    let a = square.modes(None);
+    assert_eq!(a.solver, Solver::Dense);
+    let err = modal_response_error(&mut square, &a, 3000);
+    eprintln!("square plate, proportional: {err:.2e}");
+    assert!(err < 1e-9, "square plate: {err}");
+    let mut two = engine(
+        &spec(
+            "@g ground 0.\n@a mass 1. 0. 0.\n@b mass 2. 0. 0.\n@s1 springDamper @g @a 0.3 0.\n\
+             @s2 springDamper @a @b 0.2 0.\n@d damper @b @g 0.01\n@in1 frcInput @a\n@out1 posOutput @b\n",
+        ),
+        44_100.0,
+    );
+    let a = two.modes(None);
+    assert_eq!(a.solver, Solver::Companion);
+    let err = modal_response_error(&mut two, &a, 3000);
+    eprintln!("two masses: {err:.2e}");
+    assert!(err < 1e-9, "two masses: {err}");
+    let mut plate = engine(
+        &spec(
+            "@p closedMesh 9 9 1. 0.1 0.0001 0. 0.\n@g ground 0.\n@d damper [@p 0.5 0.5] @g 0.02\n\
+             @in1 frcInput [@p 0.3 0.4]\n@out1 posOutput [@p 0.6 0.7]\n",
+        ),
+        44_100.0,
+    );
+    let a = plate.modes(None);
+    assert_eq!(a.solver, Solver::Companion);
+    let err = modal_response_error(&mut plate, &a, 3000);
+    eprintln!("plate: {err:.2e}");
+    assert!(err < 1e-9, "plate: {err}");
 }
 
 /// Non-proportional damping (a damper on one mass) goes through the companion matrix, whose
