@@ -398,8 +398,10 @@ impl Group {
     /// F₁ −= f, F₂ += f.
     #[inline(always)]
     fn apply(&self, p: &mut Points, law: impl Fn(usize, f64, f64) -> f64) {
-        for i in 0..self.len() {
-            let (ia, ib) = (self.a[i] as usize, self.b[i] as usize);
+        let n = self.len();
+        let (a, b) = (&self.a[..n], &self.b[..n]);
+        for i in 0..n {
+            let (ia, ib) = (a[i] as usize, b[i] as usize);
             let dx = p.x[ia] - p.x[ib];
             let dv = (p.x[ia] - p.xp[ia]) - (p.x[ib] - p.xp[ib]);
             let f = law(i, dx, dv);
@@ -431,54 +433,65 @@ pub(crate) struct Interactions {
 }
 
 impl Interactions {
+    /// Most models use two or three of the eight laws; an empty one costs one test (its
+    /// argument columns are not even sliced).
     #[inline]
     fn step(&self, p: &mut Points, args: &[f64]) {
         let g = &self.linear;
-        let (k, z) = (g.col(args, 0), g.col(args, 1));
-        g.apply(p, |i, dx, dv| laws::spring_damper(dx, dv, k[i], z[i]));
-
+        if g.len() > 0 {
+            let (k, z) = (g.col(args, 0), g.col(args, 1));
+            g.apply(p, |i, dx, dv| laws::spring_damper(dx, dv, k[i], z[i]));
+        }
         let g = &self.contact;
-        let (k, z, t) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
-        g.apply(p, |i, dx, dv| laws::contact(dx, dv, k[i], z[i], t[i]));
-
+        if g.len() > 0 {
+            let (k, z, t) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, dx, dv| laws::contact(dx, dv, k[i], z[i], t[i]));
+        }
         let g = &self.nl_contact;
-        let (s, c, k, z, t) = (
-            g.col(args, 0),
-            g.col(args, 1),
-            g.col(args, 2),
-            g.col(args, 3),
-            g.col(args, 4),
-        );
-        g.apply(p, |i, dx, dv| {
-            laws::nl_contact(dx, dv, s[i], c[i], k[i], z[i], t[i])
-        });
-
+        if g.len() > 0 {
+            let (s, c, k, z, t) = (
+                g.col(args, 0),
+                g.col(args, 1),
+                g.col(args, 2),
+                g.col(args, 3),
+                g.col(args, 4),
+            );
+            g.apply(p, |i, dx, dv| {
+                laws::nl_contact(dx, dv, s[i], c[i], k[i], z[i], t[i])
+            });
+        }
         let g = &self.nl_spring2;
-        let (k, q, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
-        g.apply(p, |i, dx, dv| laws::nl_spring2(dx, dv, k[i], q[i], z[i]));
-
+        if g.len() > 0 {
+            let (k, q, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, dx, dv| laws::nl_spring2(dx, dv, k[i], q[i], z[i]));
+        }
         let g = &self.nl_spring3;
-        let (k, q, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
-        g.apply(p, |i, dx, dv| laws::nl_spring3(dx, dv, k[i], q[i], z[i]));
-
+        if g.len() > 0 {
+            let (k, q, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, dx, dv| laws::nl_spring3(dx, dv, k[i], q[i], z[i]));
+        }
         let g = &self.nl_spring_damper;
-        let (s, c, k, z) = (
-            g.col(args, 0),
-            g.col(args, 1),
-            g.col(args, 2),
-            g.col(args, 3),
-        );
-        g.apply(p, |i, dx, dv| {
-            laws::nl_spring_damper(dx, dv, s[i], c[i], k[i], z[i])
-        });
-
+        if g.len() > 0 {
+            let (s, c, k, z) = (
+                g.col(args, 0),
+                g.col(args, 1),
+                g.col(args, 2),
+                g.col(args, 3),
+            );
+            g.apply(p, |i, dx, dv| {
+                laws::nl_spring_damper(dx, dv, s[i], c[i], k[i], z[i])
+            });
+        }
         let g = &self.pluck;
-        let (k, sc, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
-        g.apply(p, |i, dx, dv| laws::nl_pluck(dx, dv, k[i], sc[i], z[i]));
-
+        if g.len() > 0 {
+            let (k, sc, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, dx, dv| laws::nl_pluck(dx, dv, k[i], sc[i], z[i]));
+        }
         let g = &self.bow;
-        let (z, sc, sm) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
-        g.apply(p, |i, _dx, dv| laws::nl_bow(dv, z[i], sc[i], sm[i]));
+        if g.len() > 0 {
+            let (z, sc, sm) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, _dx, dv| laws::nl_bow(dv, z[i], sc[i], sm[i]));
+        }
     }
 }
 

@@ -124,6 +124,13 @@ impl Default for Gains {
 }
 
 /// The smoothed controls, advanced once per chunk.
+/// The inputs of one voice's gains ([`Smoothed::tune_key`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TuneKey {
+    smoothed: [f64; 3 + NUM_MACROS],
+    voice: [f64; 4],
+}
+
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Smoothed {
     stiffness: ChunkSmoother,
@@ -222,6 +229,22 @@ impl Smoothed {
             requested_stiffness: requested_k,
             requested_damping: requested_z,
             clamped,
+        }
+    }
+
+    /// Everything [`Smoothed::gains_offset`] and [`Smoothed::set`] read for one voice: when
+    /// it has not changed since the voice was last tuned, neither have its gains.
+    pub fn tune_key(&self, note_st: f64, z_factor: f64, k_octaves: f64, z_octaves: f64) -> TuneKey {
+        let mut smoothed = [0.0; 3 + NUM_MACROS];
+        smoothed[0] = self.stiffness.value;
+        smoothed[1] = self.damping.value;
+        smoothed[2] = self.tune.value;
+        for (k, m) in smoothed[3..].iter_mut().zip(&self.macros) {
+            *k = m.value;
+        }
+        TuneKey {
+            smoothed,
+            voice: [note_st, z_factor, k_octaves, z_octaves],
         }
     }
 

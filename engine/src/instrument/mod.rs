@@ -89,14 +89,18 @@ fn tune_voice(
     } else {
         1.0
     };
-    let g = smoothed.gains_offset(
-        view,
-        v.note_st + v.bend_st + v.tuning_st,
-        z,
-        v.mod_k,
-        v.mod_z,
-    );
+    let note_st = v.note_st + v.bend_st + v.tuning_st;
+    // Every chunk re-tunes every voice; most of the time nothing moved (the exact law and
+    // the clamp cost more than a small voice's 16 samples).
+    let key = smoothed.tune_key(note_st, z, v.mod_k, v.mod_z);
+    if let Some((k, g)) = v.tuned {
+        if k == key {
+            return g;
+        }
+    }
+    let g = smoothed.gains_offset(view, note_st, z, v.mod_k, v.mod_z);
     smoothed.set(&mut v.engine, view.macros, &g);
+    v.tuned = Some((key, g));
     g
 }
 

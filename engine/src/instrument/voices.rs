@@ -13,6 +13,7 @@
 //! rest does not matter: gravity and contacts leave static offsets (a dropped mass lies on its
 //! triangle, away from where it started).
 
+use super::controls::{Gains, TuneKey};
 use super::CHUNK;
 use crate::Engine;
 
@@ -69,6 +70,8 @@ pub struct Voice {
     fade_step: f64,
     /// The strike (velocity response, 0 … 1) waiting for the voice's next span.
     pub strike: f64,
+    /// What the voice was last tuned with, and the gains that gave (see `tune_voice`).
+    pub tuned: Option<(TuneKey, Gains)>,
 }
 
 /// A voice that ended, for the host (CLAP voice-terminated events).
@@ -132,6 +135,7 @@ impl VoiceBank {
             gain: 1.0,
             fade_step: 0.0,
             strike: 0.0,
+            tuned: None,
         };
         VoiceBank {
             voices: vec![voice; capacity],
@@ -214,6 +218,7 @@ impl VoiceBank {
         v.gain = 1.0;
         v.fade_step = 0.0;
         v.strike = strike;
+        v.tuned = None;
         slot
     }
 
