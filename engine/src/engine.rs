@@ -74,13 +74,20 @@ impl SingleMasses {
         self.gravity[i] = args[self.cols[3] + i];
     }
 
-    #[inline]
+    #[inline(always)]
     fn step(&self, p: &mut Points) {
         let n = self.len();
         let (x, xp, f) = (&mut p.x[..n], &mut p.xp[..n], &mut p.f[..n]);
+        // Every array sliced to n up front: no bounds checks, and no reloads of the vectors'
+        // pointers between the stores (this loop is inlined into the whole sample loop).
+        let (a, b, g, inv_m) = (
+            &self.a[..n],
+            &self.b[..n],
+            &self.gravity[..n],
+            &self.inv_m[..n],
+        );
         for i in 0..n {
-            let next =
-                self.a[i] * x[i] + self.b[i] * xp[i] + (f[i] - self.gravity[i]) * self.inv_m[i];
+            let next = a[i] * x[i] + b[i] * xp[i] + (f[i] - g[i]) * inv_m[i];
             xp[i] = x[i];
             x[i] = next;
             f[i] = 0.0;
@@ -122,7 +129,7 @@ pub(crate) struct MeshMacro {
 /// The per-step coefficients of the ground-friction node law of spec §2.7:
 /// X[n+1] = (2 − Zo/M)·X + (Zo/M − 1)·X̃ + F/M.
 #[inline(always)]
-fn node_law(m: f64, zo: f64) -> (f64, f64, f64) {
+pub(crate) fn node_law(m: f64, zo: f64) -> (f64, f64, f64) {
     let zm = zo / m;
     (2.0 - zm, zm - 1.0, 1.0 / m)
 }
@@ -140,6 +147,7 @@ pub(crate) struct Macros {
 }
 
 impl Macros {
+    #[inline(always)]
     fn step(&mut self, p: &mut Points, args: &[f64]) {
         let (v, s) = (&mut self.scratch_v, &mut self.scratch_s);
         for mac in &self.lines {
@@ -165,14 +173,14 @@ impl Macros {
             let x = &mut p.x[range.clone()];
             let xp = &mut p.xp[range.clone()];
             let f = &mut p.f[range];
-            mesh_step(mac, x, xp, f, v, s, args);
+            crate::kernels::mesh::mesh_step(mac, x, xp, f, v, s, args);
         }
     }
 }
 
 /// Moves the nodes of a line macro with the node law; fixed ends keep x = x̃ = X₀. Every
 /// node's force is reset.
-#[inline]
+#[inline(always)]
 fn update_line_nodes(mac: &LineMacro, x: &mut [f64], xp: &mut [f64], f: &mut [f64], args: &[f64]) {
     let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
     let n = x.len();
@@ -192,7 +200,7 @@ fn update_line_nodes(mac: &LineMacro, x: &mut [f64], xp: &mut [f64], f: &mut [f6
 /// The N−1 spring-dampers (i, i+1) of a line macro (spec §2.7.1–§2.7.3). The node forces are
 /// zero on entry, so F_i = (0 + s_{i−1}) − s_i: the same sum, in the same order, as applying the
 /// links one by one in script order.
-#[inline]
+#[inline(always)]
 fn chain_links(x: &[f64], xp: &[f64], f: &mut [f64], v: &mut [f64], s: &mut [f64], k: f64, z: f64) {
     let n = x.len();
     if n < 2 {
@@ -215,7 +223,7 @@ fn chain_links(x: &[f64], xp: &[f64], f: &mut [f64], v: &mut [f64], s: &mut [f64
 
 /// The stiff string's undamped K₂ springs (spec §2.7.3): f = K₂(x_a − x_b) for
 /// a = clip(i, 0, N−1), b = clip(i+2, 0, N−1), i = −1..N−1, applied in that order.
-#[inline]
+#[inline(always)]
 fn stiffness_links(x: &[f64], f: &mut [f64], k2: f64) {
     let n = x.len() as isize;
     for i in -1..n {
@@ -224,69 +232,6 @@ fn stiffness_links(x: &[f64], f: &mut [f64], k2: f64) {
         let t = k2 * (x[a] - x[b]);
         f[a] -= t;
         f[b] += t;
-    }
-}
-
-/// One step of a mesh (spec §2.7.4): every node moves with the node law; pinned nodes are then
-/// reset to x = x̃ = x_edge (node 0's position before the update) with F = 0; then the links
-/// (i,j)–(i,j+1) for all rows, then (i,j)–(i+1,j).
-#[inline]
-fn mesh_step(
-    mac: &MeshMacro,
-    x: &mut [f64],
-    xp: &mut [f64],
-    f: &mut [f64],
-    v: &mut [f64],
-    s: &mut [f64],
-    args: &[f64],
-) {
-    let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
-    let (k, z) = (args[mac.slots.k], args[mac.slots.z]);
-    let (len, w) = (mac.length, mac.width);
-    let n = len * w;
-    let x_edge = x[0];
-    for i in 0..n {
-        let next = a * x[i] + b * xp[i] + f[i] * inv_m;
-        xp[i] = x[i];
-        x[i] = next;
-    }
-    for &p in &mac.pinned {
-        x[p as usize] = x_edge;
-        xp[p as usize] = x_edge;
-    }
-    let v = &mut v[..n];
-    for i in 0..n {
-        v[i] = x[i] - xp[i];
-    }
-    // Links along the width, row by row. F is zero on entry (as in `chain_links`).
-    for row in 0..len {
-        let r = row * w;
-        let (xr, vr, fr) = (&x[r..r + w], &v[r..r + w], &mut f[r..r + w]);
-        let sr = &mut s[..w - 1];
-        for j in 0..w - 1 {
-            sr[j] = laws::spring_damper(xr[j] - xr[j + 1], vr[j] - vr[j + 1], k, z);
-        }
-        fr[0] = -sr[0];
-        for j in 1..w - 1 {
-            fr[j] = sr[j - 1] - sr[j];
-        }
-        fr[w - 1] = sr[w - 2];
-    }
-    // Links along the length: (n, n + W) for n < (L−1)·W. Node n receives +s[n−W] before
-    // −s[n], as in script order.
-    let m = (len - 1) * w;
-    let s = &mut s[..m];
-    for i in 0..m {
-        s[i] = laws::spring_damper(x[i] - x[i + w], v[i] - v[i + w], k, z);
-    }
-    for i in 0..w.min(m) {
-        f[i] -= s[i];
-    }
-    for i in w..m {
-        f[i] = f[i] + s[i - w] - s[i];
-    }
-    for i in m.max(w)..n {
-        f[i] += s[i - w];
     }
 }
 
@@ -350,7 +295,7 @@ impl Proxies {
 
     /// Stage 3: x̃_P ← x_P, x_P ← Σ w·x_node. The force slot is cleared here, after stage 6 of
     /// the previous step read it (it holds F_P for `frcOutput`, spec §3.12 e).
-    #[inline]
+    #[inline(always)]
     fn update_positions(&self, p: &mut Points) {
         for i in 0..self.len() {
             let pos = self.interpolate(i, &p.x);
@@ -362,7 +307,7 @@ impl Proxies {
     }
 
     /// Stage 5: spread F_P onto the macro nodes, in creation order.
-    #[inline]
+    #[inline(always)]
     fn spread_forces(&self, p: &mut Points) {
         for i in 0..self.len() {
             let fp = p.f[self.base + i];
@@ -435,7 +380,10 @@ pub(crate) struct Interactions {
 impl Interactions {
     /// Most models use two or three of the eight laws; an empty one costs one test (its
     /// argument columns are not even sliced).
-    #[inline]
+    // Not inlined: a function of its own keeps `p` and `args` apart for the optimiser
+    // (inlined into the sample loop, every store to a force reloaded the arrays' pointers,
+    // and the element-by-element string ran 1.5 times slower).
+    #[inline(never)]
     fn step(&self, p: &mut Points, args: &[f64]) {
         let g = &self.linear;
         if g.len() > 0 {
@@ -665,6 +613,36 @@ pub struct Engine {
     pub(crate) motion: Option<Arc<MotionStore>>,
     pub(crate) motion_interval: u32,
     pub(crate) motion_counter: u32,
+    /// The instruction set the sample loop runs with, detected once: the loop is compiled for
+    /// the baseline and for AVX2 (pulp's x86-v3), and [`Engine::process`] picks one per block.
+    /// Without FMA contraction both give the same IEEE operations, so the same samples.
+    pub(crate) arch: pulp::Arch,
+}
+
+/// One block of [`Engine::process`] as a pulp operation: `with_simd` is inlined into the
+/// instruction set's `#[target_feature]` entry point, and with it the whole sample loop.
+struct Block<'a> {
+    engine: &'a mut Engine,
+    frames: usize,
+    inputs: &'a [f64],
+    in_channels: usize,
+    outputs: &'a mut [f64],
+    out_channels: usize,
+}
+
+impl pulp::WithSimd for Block<'_> {
+    type Output = usize;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> usize {
+        self.engine.run(
+            self.frames,
+            self.inputs,
+            self.in_channels,
+            self.outputs,
+            self.out_channels,
+        )
+    }
 }
 
 /// An error setting a parameter.
@@ -1017,35 +995,15 @@ impl Engine {
         let was_tripped = self.guard.is_some();
         let mut simulated = 0;
         if !was_tripped {
-            let scale = self.class_factors();
-            for n in 0..frames {
-                let input = |ch: u32| -> f64 {
-                    let ch = ch as usize;
-                    if ch < in_channels {
-                        let v = inputs[ch * frames + n];
-                        if v.is_finite() {
-                            v
-                        } else {
-                            0.0
-                        }
-                    } else {
-                        0.0
-                    }
-                };
-                self.step(&input, &scale);
-                simulated += 1;
-                if let Some(bad) = self.write_outputs(n, frames, out_channels, outputs) {
-                    self.trip(bad.0, None, Some(bad.1));
-                    for ch in 0..out_channels {
-                        outputs[ch * frames + n..(ch + 1) * frames].fill(0.0);
-                    }
-                    break;
-                }
-                self.samples_since_reset += 1;
-                if self.samples_since_reset.is_multiple_of(FLUSH_INTERVAL) {
-                    self.flush_tiny();
-                }
-            }
+            let arch = self.arch;
+            simulated = arch.dispatch(Block {
+                engine: self,
+                frames,
+                inputs,
+                in_channels,
+                outputs,
+                out_channels,
+            });
             if self.guard.is_none() {
                 self.scan_positions();
             }
@@ -1056,8 +1014,52 @@ impl Engine {
         }
     }
 
+    /// The sample loop of [`Engine::process`], inlined into each instruction set's copy.
+    /// Returns how many samples ran (fewer when the guard trips).
+    #[inline(always)]
+    fn run(
+        &mut self,
+        frames: usize,
+        inputs: &[f64],
+        in_channels: usize,
+        outputs: &mut [f64],
+        out_channels: usize,
+    ) -> usize {
+        let scale = self.class_factors();
+        let mut simulated = 0;
+        for n in 0..frames {
+            let input = |ch: u32| -> f64 {
+                let ch = ch as usize;
+                if ch < in_channels {
+                    let v = inputs[ch * frames + n];
+                    if v.is_finite() {
+                        v
+                    } else {
+                        0.0
+                    }
+                } else {
+                    0.0
+                }
+            };
+            self.step(&input, &scale);
+            simulated += 1;
+            if let Some(bad) = self.write_outputs(n, frames, out_channels, outputs) {
+                self.trip(bad.0, None, Some(bad.1));
+                for ch in 0..out_channels {
+                    outputs[ch * frames + n..(ch + 1) * frames].fill(0.0);
+                }
+                break;
+            }
+            self.samples_since_reset += 1;
+            if self.samples_since_reset.is_multiple_of(FLUSH_INTERVAL) {
+                self.flush_tiny();
+            }
+        }
+        simulated
+    }
+
     /// One sample: stages 1 to 5 and 7 of spec §1.5 (stage 6 is `write_outputs`).
-    #[inline]
+    #[inline(always)]
     fn step(&mut self, input: &impl Fn(u32) -> f64, scale: &[f64; NUM_ARG_CLASSES]) {
         // Stage 1 a: avatars.
         for r in &self.avatars {
@@ -1107,7 +1109,7 @@ impl Engine {
 
     /// Stage 6: writes frame `n` of every output. Returns the first bad value's kind and
     /// channel, if any.
-    #[inline]
+    #[inline(always)]
     fn write_outputs(
         &self,
         n: usize,
@@ -1144,6 +1146,7 @@ impl Engine {
     /// Sets every position, delayed position and pending force below [`FLUSH_BELOW`] to exactly
     /// 0 (a select, not a branch, so that it vectorises). The forces count: stage 4 leaves them
     /// for the next sample's mass update, and a tail flushed without them comes back from them.
+    #[inline(always)]
     fn flush_tiny(&mut self) {
         let p = &mut self.points;
         for v in p.x.iter_mut().chain(p.xp.iter_mut()).chain(p.f.iter_mut()) {

@@ -27,6 +27,7 @@ pub mod expr;
 pub mod generators;
 pub mod info;
 pub mod instrument;
+mod kernels;
 pub mod lang;
 pub mod laws;
 pub mod modes;

@@ -102,6 +102,7 @@ impl<'a> Cx<'a> {
             motion: None,
             motion_interval: options.motion_interval.max(1),
             motion_counter: 0,
+            arch: pulp::Arch::new(),
         };
         engine.reset();
         Ok(engine)

@@ -178,7 +178,8 @@ impl<'a> Cx<'a> {
             let (zo, _) = self.slot(&mac.zo, ArgClass::Damping, i);
             let slots = MacroSlots { m, k, k2, z, zo };
             let n = mac.num_nodes();
-            largest_macro = largest_macro.max(n);
+            // The mesh kernel keeps two rows of velocities.
+            largest_macro = largest_macro.max(n).max(2 * mac.width as usize);
             let base_us = base as usize;
             let (x0, _) = self.expr(mac.pos.z(), i);
             let (v, _) = self.expr(mac.vel.z(), i);
@@ -209,7 +210,13 @@ impl<'a> Cx<'a> {
                         base: base_us,
                         length: mac.length as usize,
                         width: mac.width as usize,
-                        pinned: fixed.clone(),
+                        // Ascending: the mesh kernel pins them row by row.
+                        pinned: {
+                            let mut p = fixed.clone();
+                            p.sort_unstable();
+                            p.dedup();
+                            p
+                        },
                         slots,
                     })
                 }
