@@ -345,13 +345,16 @@ impl Group {
     fn apply(&self, p: &mut Points, law: impl Fn(usize, f64, f64) -> f64) {
         let n = self.len();
         let (a, b) = (&self.a[..n], &self.b[..n]);
+        // Local slices: the stores to `f` cannot move the arrays, so their pointers and
+        // lengths stay in registers.
+        let (x, xp, f) = (&p.x[..], &p.xp[..], &mut p.f[..]);
         for i in 0..n {
             let (ia, ib) = (a[i] as usize, b[i] as usize);
-            let dx = p.x[ia] - p.x[ib];
-            let dv = (p.x[ia] - p.xp[ia]) - (p.x[ib] - p.xp[ib]);
-            let f = law(i, dx, dv);
-            p.f[ia] -= f;
-            p.f[ib] += f;
+            let dx = x[ia] - x[ib];
+            let dv = (x[ia] - xp[ia]) - (x[ib] - xp[ib]);
+            let force = law(i, dx, dv);
+            f[ia] -= force;
+            f[ib] += force;
         }
     }
 }
@@ -380,10 +383,7 @@ pub(crate) struct Interactions {
 impl Interactions {
     /// Most models use two or three of the eight laws; an empty one costs one test (its
     /// argument columns are not even sliced).
-    // Not inlined: a function of its own keeps `p` and `args` apart for the optimiser
-    // (inlined into the sample loop, every store to a force reloaded the arrays' pointers,
-    // and the element-by-element string ran 1.5 times slower).
-    #[inline(never)]
+    #[inline(always)]
     fn step(&self, p: &mut Points, args: &[f64]) {
         let g = &self.linear;
         if g.len() > 0 {
