@@ -28,6 +28,7 @@ pub mod generators;
 pub mod info;
 pub mod instrument;
 mod kernels;
+pub mod lanes;
 pub mod lang;
 pub mod laws;
 pub mod modes;

@@ -25,7 +25,11 @@ mod tests {
             let mut plain = fast.clone();
             plain.arch = pulp::Arch::Scalar;
             let (n_in, n_out) = (fast.info().num_inputs(), fast.info().num_outputs());
-            let frames = if fast.info().num_points > 5000 { 256 } else { 4096 };
+            let frames = if fast.info().num_points > 5000 {
+                256
+            } else {
+                4096
+            };
             let mut inputs = vec![0.0; n_in * frames];
             for c in 0..n_in {
                 inputs[c * frames] = -0.01;
@@ -36,7 +40,12 @@ mod tests {
             plain.process(frames, &inputs, &mut b);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&a), bits(&b), "{}", path.display());
-            assert_eq!(bits(fast.positions()), bits(plain.positions()), "{}", path.display());
+            assert_eq!(
+                bits(fast.positions()),
+                bits(plain.positions()),
+                "{}",
+                path.display()
+            );
         }
     }
 }

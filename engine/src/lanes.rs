@@ -1,0 +1,511 @@
+//! Voice lanes (issue 12): [`LANES`] copies of one compiled model stepped together, the copy
+//! the fastest axis of the state (`x[point][lane]`), so that every kernel runs four voices per
+//! instruction. The copies share the structure and the parameters; each lane has its own
+//! state, class gains (its tuning, Release, polyphonic modulation), inputs, outputs, guard and
+//! flush phase.
+//!
+//! Each lane computes exactly what a plain [`Engine`] computes with the same gains and inputs:
+//! the same IEEE operations in the same order (spec §1.5's stages, the laws of spec §2), so a
+//! lane equals a plain engine bit for bit (engine test `lanes`). Arguments are
+//! `expression value × (class scale × lane gain)`, as [`Engine`]'s `class_factors`.
+//!
+//! Models with macros, connection points, position inputs or audio-rate parameters are not
+//! laned ([`LaneEngine::supports`]); they keep one [`Engine`] per voice.
+
+use crate::engine::{ArgClass, Group, NUM_ARG_CLASSES};
+use crate::engine::{FLUSH_BELOW, FLUSH_INTERVAL};
+use crate::laws;
+use crate::spec::ScaleClass;
+use crate::{Engine, ParamError, ParamId};
+
+/// Voices per lane group.
+pub const LANES: usize = 4;
+
+type Lanes = [f64; LANES];
+
+/// [`LANES`] voices of one model. See the module documentation.
+#[derive(Clone, Debug)]
+pub struct LaneEngine {
+    /// The model: structure, parameters, expressions, and (after `reset`) the rest state.
+    template: Engine,
+    /// The template's rest state is stale (a parameter changed since it was taken).
+    rest_stale: bool,
+    /// Expression value of every control binding, by slot (no class factor).
+    raw: Vec<f64>,
+    /// Host gain of each class, per lane.
+    gains: [[f64; NUM_ARG_CLASSES]; LANES],
+    /// Arguments per slot, per lane.
+    args: Vec<Lanes>,
+    /// Single mass-type coefficients per point, per lane (spec §2.1.2).
+    a: Vec<Lanes>,
+    b: Vec<Lanes>,
+    inv_m: Vec<Lanes>,
+    gravity: Vec<Lanes>,
+    x: Vec<Lanes>,
+    xp: Vec<Lanes>,
+    f: Vec<Lanes>,
+    params_dirty: bool,
+    gains_dirty: [bool; LANES],
+    samples_since_reset: [u64; LANES],
+    tripped: [bool; LANES],
+    arch: pulp::Arch,
+}
+
+impl LaneEngine {
+    /// Whether a model can run in lanes: single mass-type elements, interactions, force
+    /// inputs and outputs only.
+    pub fn supports(engine: &Engine) -> bool {
+        engine.macros.lines.is_empty()
+            && engine.macros.stiff.is_empty()
+            && engine.macros.meshes.is_empty()
+            && engine.proxies.len() == 0
+            && engine.avatars.is_empty()
+            && engine.audio_params.is_empty()
+            && engine.audio_bindings.is_empty()
+    }
+
+    /// Four voices of `template`, every lane at rest with the template's class gains.
+    /// Allocates: call it off the audio thread. `None` when the model is not supported.
+    pub fn new(template: &Engine) -> Option<LaneEngine> {
+        if !LaneEngine::supports(template) {
+            return None;
+        }
+        let mut template = template.clone();
+        template.reset();
+        let n = template.points.x.len();
+        let slots = template.args.len();
+        // Slots no binding writes keep the values the compiler gave them.
+        let args = template.args.iter().map(|&v| [v; LANES]).collect();
+        let singles = template.singles.len();
+        let zero = [0.0; LANES];
+        let mut lanes = LaneEngine {
+            gains: [template.class_gain; LANES],
+            template,
+            rest_stale: false,
+            raw: vec![0.0; slots],
+            args,
+            a: vec![zero; singles],
+            b: vec![zero; singles],
+            inv_m: vec![zero; singles],
+            gravity: vec![zero; singles],
+            x: vec![zero; n],
+            xp: vec![zero; n],
+            f: vec![zero; n],
+            params_dirty: true,
+            gains_dirty: [true; LANES],
+            samples_since_reset: [0; LANES],
+            tripped: [false; LANES],
+            arch: pulp::Arch::new(),
+        };
+        lanes.refresh();
+        for l in 0..LANES {
+            lanes.reset_lane(l);
+        }
+        Some(lanes)
+    }
+
+    /// The model every lane runs.
+    pub fn template(&self) -> &Engine {
+        &self.template
+    }
+
+    /// Sets a parameter of every lane (they share parameters), from the next block on.
+    /// Realtime-safe.
+    pub fn set_param(&mut self, id: ParamId, value: f64) -> Result<(), ParamError> {
+        let before = self.template.param(id);
+        self.template.set_param(id, value)?;
+        if before != Some(value) {
+            self.params_dirty = true;
+            self.rest_stale = true;
+        }
+        Ok(())
+    }
+
+    /// [`Engine::set_class_gain`] for one lane. Realtime-safe.
+    pub fn set_class_gain(&mut self, lane: usize, class: ScaleClass, gain: f64) {
+        let slot = match class {
+            ScaleClass::Stiffness => ArgClass::Stiffness,
+            ScaleClass::Damping => ArgClass::Damping,
+            ScaleClass::None | ScaleClass::Gravity => return,
+        } as usize;
+        if lane < LANES && gain.is_finite() && gain >= 0.0 && self.gains[lane][slot] != gain {
+            self.gains[lane][slot] = gain;
+            self.gains_dirty[lane] = true;
+        }
+    }
+
+    /// Puts lane `lane` at the model's initial state (spec §1.5 stage 0) at the current
+    /// parameters, and clears its guard. Realtime-safe.
+    pub fn reset_lane(&mut self, lane: usize) {
+        if lane >= LANES {
+            return;
+        }
+        if self.rest_stale {
+            self.template.reset();
+            self.rest_stale = false;
+        }
+        self.refresh();
+        let p = &self.template.points;
+        for (i, ((x, xp), f)) in self
+            .x
+            .iter_mut()
+            .zip(&mut self.xp)
+            .zip(&mut self.f)
+            .enumerate()
+        {
+            x[lane] = p.x[i];
+            xp[lane] = p.xp[i];
+            f[lane] = p.f[i];
+        }
+        self.samples_since_reset[lane] = 0;
+        self.tripped[lane] = false;
+    }
+
+    /// Whether lane `lane`'s guard has tripped (a non-finite or runaway value): its outputs
+    /// stay 0 until [`LaneEngine::reset_lane`].
+    pub fn is_tripped(&self, lane: usize) -> bool {
+        self.tripped.get(lane).copied().unwrap_or(false)
+    }
+
+    /// Lane `lane`'s positions and delayed positions, point by point, into `x` and `xp`
+    /// (as many as they hold).
+    pub fn lane_state(&self, lane: usize, x: &mut [f64], xp: &mut [f64]) {
+        for (o, v) in x.iter_mut().zip(&self.x) {
+            *o = v[lane];
+        }
+        for (o, v) in xp.iter_mut().zip(&self.xp) {
+            *o = v[lane];
+        }
+    }
+
+    /// Re-evaluates the arguments and coefficients after a parameter or gain change.
+    fn refresh(&mut self) {
+        let t = &mut self.template;
+        if self.params_dirty {
+            for bind in &t.control_bindings {
+                self.raw[bind.slot as usize] = t.program.eval(bind.expr, &t.params, &mut t.stack);
+            }
+            self.gains_dirty = [true; LANES];
+            self.params_dirty = false;
+        }
+        for l in 0..LANES {
+            if !self.gains_dirty[l] {
+                continue;
+            }
+            // The factors as `Engine::class_factors` forms them: scale × gain.
+            let mut scale = t.class_scale;
+            for (s, g) in scale.iter_mut().zip(self.gains[l]) {
+                *s *= g;
+            }
+            for bind in &t.control_bindings {
+                let slot = bind.slot as usize;
+                self.args[slot][l] = self.raw[slot] * scale[bind.class as usize];
+            }
+            let s = &t.singles;
+            for i in 0..s.len() {
+                if s.fixed[i] {
+                    self.a[i][l] = 1.0;
+                    self.b[i][l] = 0.0;
+                    self.inv_m[i][l] = 0.0;
+                    self.gravity[i][l] = 0.0;
+                    continue;
+                }
+                let m = self.args[s.cols[0] + i][l];
+                let k = self.args[s.cols[1] + i][l];
+                let z = self.args[s.cols[2] + i][l];
+                self.a[i][l] = 2.0 - (k + z) / m;
+                self.b[i][l] = z / m - 1.0;
+                self.inv_m[i][l] = 1.0 / m;
+                self.gravity[i][l] = self.args[s.cols[3] + i][l];
+            }
+            self.gains_dirty[l] = false;
+        }
+    }
+
+    /// Runs `frames` samples of every lane. `inputs` holds the input channels one after the
+    /// other, each `frames` samples of [`LANES`] values (`inputs[(c·frames + n)·LANES + l]`);
+    /// `outputs` the same for the output channels. Non-finite inputs count as 0; a tripped
+    /// lane writes zeros. Returns which lanes tripped during this block. Realtime-safe.
+    pub fn process(&mut self, frames: usize, inputs: &[f64], outputs: &mut [f64]) -> [bool; LANES] {
+        let per_channel = frames * LANES;
+        let out_channels = outputs.len().checked_div(per_channel).unwrap_or(0);
+        let in_channels = inputs.len().checked_div(per_channel).unwrap_or(0);
+        outputs[..out_channels * per_channel].fill(0.0);
+        if self.params_dirty || self.gains_dirty.iter().any(|d| *d) {
+            self.refresh();
+        }
+        let before = self.tripped;
+        let arch = self.arch;
+        arch.dispatch(LaneBlock {
+            lanes: self,
+            frames,
+            inputs,
+            in_channels,
+            outputs,
+            out_channels,
+        });
+        self.scan_positions();
+        std::array::from_fn(|l| self.tripped[l] && !before[l])
+    }
+
+    #[inline(always)]
+    fn run(
+        &mut self,
+        frames: usize,
+        inputs: &[f64],
+        in_channels: usize,
+        outputs: &mut [f64],
+        out_channels: usize,
+    ) {
+        for n in 0..frames {
+            self.step(n, frames, inputs, in_channels);
+            self.write_outputs(n, frames, out_channels, outputs);
+            for l in 0..LANES {
+                self.samples_since_reset[l] += 1;
+                if self.samples_since_reset[l].is_multiple_of(FLUSH_INTERVAL) {
+                    self.flush_lane(l);
+                }
+            }
+        }
+    }
+
+    /// One sample of every lane: stages 2 a, 4 (interactions, then force inputs) of spec §1.5.
+    #[inline(always)]
+    fn step(&mut self, n: usize, frames: usize, inputs: &[f64], in_channels: usize) {
+        // Stage 2 a: X[n+1] = a·X + b·X̃ + (F − g)·(1/M).
+        let count = self.a.len();
+        let (x, xp, f) = (
+            &mut self.x[..count],
+            &mut self.xp[..count],
+            &mut self.f[..count],
+        );
+        let (a, b, g, inv_m) = (
+            &self.a[..count],
+            &self.b[..count],
+            &self.gravity[..count],
+            &self.inv_m[..count],
+        );
+        for i in 0..count {
+            for l in 0..LANES {
+                let next =
+                    a[i][l] * x[i][l] + b[i][l] * xp[i][l] + (f[i][l] - g[i][l]) * inv_m[i][l];
+                xp[i][l] = x[i][l];
+                x[i][l] = next;
+                f[i][l] = 0.0;
+            }
+        }
+        // Stage 4: the interactions, one loop per law, then the force inputs.
+        let it = &self.template.interactions;
+        let args = &self.args[..];
+        let (x, xp, f) = (&self.x[..], &self.xp[..], &mut self.f[..]);
+        apply(&it.linear, x, xp, f, |i, l, dx, dv| {
+            let c = &it.linear.cols;
+            laws::spring_damper(dx, dv, args[c[0] + i][l], args[c[1] + i][l])
+        });
+        apply(&it.contact, x, xp, f, |i, l, dx, dv| {
+            let c = &it.contact.cols;
+            laws::contact(
+                dx,
+                dv,
+                args[c[0] + i][l],
+                args[c[1] + i][l],
+                args[c[2] + i][l],
+            )
+        });
+        apply(&it.nl_contact, x, xp, f, |i, l, dx, dv| {
+            let c = &it.nl_contact.cols;
+            laws::nl_contact(
+                dx,
+                dv,
+                args[c[0] + i][l],
+                args[c[1] + i][l],
+                args[c[2] + i][l],
+                args[c[3] + i][l],
+                args[c[4] + i][l],
+            )
+        });
+        apply(&it.nl_spring2, x, xp, f, |i, l, dx, dv| {
+            let c = &it.nl_spring2.cols;
+            laws::nl_spring2(
+                dx,
+                dv,
+                args[c[0] + i][l],
+                args[c[1] + i][l],
+                args[c[2] + i][l],
+            )
+        });
+        apply(&it.nl_spring3, x, xp, f, |i, l, dx, dv| {
+            let c = &it.nl_spring3.cols;
+            laws::nl_spring3(
+                dx,
+                dv,
+                args[c[0] + i][l],
+                args[c[1] + i][l],
+                args[c[2] + i][l],
+            )
+        });
+        apply(&it.nl_spring_damper, x, xp, f, |i, l, dx, dv| {
+            let c = &it.nl_spring_damper.cols;
+            laws::nl_spring_damper(
+                dx,
+                dv,
+                args[c[0] + i][l],
+                args[c[1] + i][l],
+                args[c[2] + i][l],
+                args[c[3] + i][l],
+            )
+        });
+        apply(&it.pluck, x, xp, f, |i, l, dx, dv| {
+            let c = &it.pluck.cols;
+            laws::nl_pluck(
+                dx,
+                dv,
+                args[c[0] + i][l],
+                args[c[1] + i][l],
+                args[c[2] + i][l],
+            )
+        });
+        apply(&it.bow, x, xp, f, |i, l, _dx, dv| {
+            let c = &it.bow.cols;
+            laws::nl_bow(dv, args[c[0] + i][l], args[c[1] + i][l], args[c[2] + i][l])
+        });
+        for r in &self.template.force_inputs {
+            let ch = r.channel as usize;
+            let fi = &mut f[r.index as usize];
+            if ch >= in_channels {
+                // A silent channel adds 0 as the plain engine does (−0 + 0 = +0).
+                for v in fi.iter_mut() {
+                    *v += 0.0;
+                }
+                continue;
+            }
+            let at = (ch * frames + n) * LANES;
+            for l in 0..LANES {
+                let v = inputs[at + l];
+                fi[l] += if v.is_finite() { v } else { 0.0 };
+            }
+        }
+    }
+
+    /// Stage 6: frame `n` of every output of every lane; a lane whose output is non-finite
+    /// or beyond the position limit trips (its outputs are 0 from this sample on).
+    #[inline(always)]
+    fn write_outputs(&mut self, n: usize, frames: usize, out_channels: usize, outputs: &mut [f64]) {
+        let limit = self.template.position_limit;
+        let t = &self.template;
+        let mut put = |channel: u32, v: Lanes, tripped: &mut [bool; LANES]| {
+            let ch = channel as usize;
+            for l in 0..LANES {
+                if !(v[l].is_finite() && v[l].abs() <= limit) {
+                    tripped[l] = true;
+                }
+            }
+            if ch < out_channels {
+                let at = (ch * frames + n) * LANES;
+                for l in 0..LANES {
+                    outputs[at + l] = if tripped[l] { 0.0 } else { v[l] };
+                }
+            }
+        };
+        let mut tripped = self.tripped;
+        for r in &t.pos_outputs {
+            put(r.channel, self.x[r.index as usize], &mut tripped);
+        }
+        for &(channel, start, len) in &t.frc_outputs {
+            let sources = &t.frc_sources[start as usize..(start + len) as usize];
+            let total: Lanes =
+                std::array::from_fn(|l| sources.iter().map(|&p| self.f[p as usize][l]).sum());
+            put(channel, total, &mut tripped);
+        }
+        if tripped != self.tripped {
+            // An output that tripped a lane on this sample was written before the check of a
+            // later channel: clear the lane's frame on every channel, as the plain engine does.
+            for l in 0..LANES {
+                if tripped[l] && !self.tripped[l] {
+                    for ch in 0..out_channels {
+                        outputs[(ch * frames + n) * LANES + l] = 0.0;
+                    }
+                }
+            }
+            self.tripped = tripped;
+        }
+    }
+
+    /// [`Engine`]'s flush below [`FLUSH_BELOW`], for one lane.
+    fn flush_lane(&mut self, l: usize) {
+        for v in self
+            .x
+            .iter_mut()
+            .chain(self.xp.iter_mut())
+            .chain(self.f.iter_mut())
+        {
+            v[l] = if v[l].abs() < FLUSH_BELOW { 0.0 } else { v[l] };
+        }
+    }
+
+    /// Checks every position of every lane at the end of a block.
+    fn scan_positions(&mut self) {
+        let limit = self.template.position_limit;
+        for x in &self.x {
+            for l in 0..LANES {
+                if !(x[l].abs() <= limit) {
+                    self.tripped[l] = true;
+                }
+            }
+        }
+    }
+}
+
+/// `law(i, lane, Δx, Δv)` on every pair of a group and every lane, with the convention of
+/// spec §1.3: F₁ −= f, F₂ += f.
+#[inline(always)]
+fn apply(
+    g: &Group,
+    x: &[Lanes],
+    xp: &[Lanes],
+    f: &mut [Lanes],
+    law: impl Fn(usize, usize, f64, f64) -> f64,
+) {
+    let n = g.len();
+    let (a, b) = (&g.a[..n], &g.b[..n]);
+    for i in 0..n {
+        let (ia, ib) = (a[i] as usize, b[i] as usize);
+        let (xa, xb, xpa, xpb) = (x[ia], x[ib], xp[ia], xp[ib]);
+        let force: Lanes = std::array::from_fn(|l| {
+            let dx = xa[l] - xb[l];
+            let dv = (xa[l] - xpa[l]) - (xb[l] - xpb[l]);
+            law(i, l, dx, dv)
+        });
+        for l in 0..LANES {
+            f[ia][l] -= force[l];
+        }
+        for l in 0..LANES {
+            f[ib][l] += force[l];
+        }
+    }
+}
+
+/// One block of [`LaneEngine::process`] as a pulp operation (see `Engine::process`).
+struct LaneBlock<'a> {
+    lanes: &'a mut LaneEngine,
+    frames: usize,
+    inputs: &'a [f64],
+    in_channels: usize,
+    outputs: &'a mut [f64],
+    out_channels: usize,
+}
+
+impl pulp::WithSimd for LaneBlock<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        self.lanes.run(
+            self.frames,
+            self.inputs,
+            self.in_channels,
+            self.outputs,
+            self.out_channels,
+        )
+    }
+}

@@ -1,0 +1,168 @@
+//! Voice lanes: every lane of a `LaneEngine` computes what a plain `Engine` computes with the
+//! same class gains and inputs, bit for bit (issue 12: "a bank of one equals today's engine").
+
+mod common;
+
+use common::engine;
+use ressort_engine::lanes::{LaneEngine, LANES};
+use ressort_engine::{parse, Engine, ModelSpec, ScaleClass};
+
+fn spec(text: &str) -> ModelSpec {
+    let parsed = parse(text);
+    parsed.spec.expect("a spec")
+}
+
+fn preset(name: &str) -> ModelSpec {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../models")
+        .join(name);
+    spec(&std::fs::read_to_string(path).unwrap())
+}
+
+/// An element-by-element string with a plucked and a bowed point, every linear and
+/// nonlinear law the lanes run, two force inputs and a force output.
+const MIXED: &str = "\
+@g ground 0.
+@m1 mass 1. 0. 0.
+@m2 mass 1.2 0. 0.
+@m3 mass 0.9 0. 0.
+@m4 osc 1. 0.05 0.0001 0. 0.
+@m5 mass 1. 0. 0.
+@g2 ground 0.
+@r1 springDamper @g @m1 0.1 0.001
+@r2 spring @m1 @m2 0.12
+@r3 damper @m2 @m3 0.002
+@r4 nlSpring2 @m3 @m4 0.1 0.5 0.001
+@r5 nlSpring3 @m4 @m5 0.1 2. 0.001
+@r6 springDamper @m5 @g2 0.1 0.001
+@c contact @m2 @m5 0.05 0.001 0.
+@p nlPluck @m3 @g 0.05 0.001 0.001
+@in1 frcInput @m1
+@in2 frcInput @m4
+@out1 posOutput @m3
+@out2 frcOutput @m2
+";
+
+/// Runs `lanes` and one plain engine per lane for `blocks` blocks of `frames`, lane l with
+/// stiffness gain `k[l]`, damping gain `z[l]` and an impulse of `strike[l]` on every input,
+/// and compares every output sample's bits.
+fn lanes_equal_plain(
+    spec: &ModelSpec,
+    sr: f64,
+    k: [f64; LANES],
+    z: [f64; LANES],
+    strike: [f64; LANES],
+) {
+    let template = engine(spec, sr);
+    let mut lanes = LaneEngine::new(&template).expect("the model runs in lanes");
+    let mut plain: Vec<Engine> = (0..LANES).map(|_| template.clone()).collect();
+    for l in 0..LANES {
+        lanes.set_class_gain(l, ScaleClass::Stiffness, k[l]);
+        lanes.set_class_gain(l, ScaleClass::Damping, z[l]);
+        plain[l].set_class_gain(ScaleClass::Stiffness, k[l]);
+        plain[l].set_class_gain(ScaleClass::Damping, z[l]);
+        plain[l].reset();
+        lanes.reset_lane(l);
+    }
+    let (n_in, n_out) = (template.info().num_inputs(), template.info().num_outputs());
+    let frames = 16;
+    let mut lane_in = vec![0.0; n_in * frames * LANES];
+    let mut lane_out = vec![0.0; n_out * frames * LANES];
+    let mut one_in = vec![0.0; n_in * frames];
+    let mut one_out = vec![0.0; n_out * frames];
+    let mut loudest = 0.0f64;
+    for block in 0..400 {
+        lane_in.fill(0.0);
+        for c in 0..n_in {
+            for l in 0..LANES {
+                if block == 0 {
+                    lane_in[(c * frames) * LANES + l] = strike[l];
+                }
+            }
+        }
+        lanes.process(frames, &lane_in, &mut lane_out);
+        for l in 0..LANES {
+            for c in 0..n_in {
+                for n in 0..frames {
+                    one_in[c * frames + n] = lane_in[(c * frames + n) * LANES + l];
+                }
+            }
+            plain[l].process(frames, &one_in, &mut one_out);
+            for c in 0..n_out {
+                for n in 0..frames {
+                    let (a, b) = (
+                        one_out[c * frames + n],
+                        lane_out[(c * frames + n) * LANES + l],
+                    );
+                    loudest = loudest.max(a.abs());
+                    assert_eq!(
+                        a.to_bits(),
+                        b.to_bits(),
+                        "lane {l}, output {c}, sample {}: plain {a} vs lane {b}",
+                        block * frames + n
+                    );
+                }
+            }
+        }
+    }
+    assert!(loudest > 1e-6, "the model hardly moved: {loudest}");
+}
+
+#[test]
+fn each_lane_is_a_plain_engine_bit_for_bit() {
+    let k = [1.0, 0.5, 1.7, 2.3];
+    let z = [1.0, 2.0, 0.6, 1.3];
+    let strike = [-0.01, -0.02, 0.015, -0.005];
+    lanes_equal_plain(&spec(MIXED), 48_000.0, k, z, strike);
+    lanes_equal_plain(&preset("drunk-triangles.mdl"), 48_000.0, k, z, strike);
+    lanes_equal_plain(
+        &preset("drunk-triangles.mdl"),
+        44_100.0,
+        [1.0; LANES],
+        [1.0; LANES],
+        strike,
+    );
+}
+
+/// A lane reset mid-flight starts again from rest while the others ring on; a lane that
+/// blows up trips alone.
+#[test]
+fn a_lane_resets_and_trips_alone() {
+    let template = engine(&spec(MIXED), 48_000.0);
+    let mut lanes = LaneEngine::new(&template).unwrap();
+    let frames = 16;
+    let n_out = template.info().num_outputs();
+    let mut input = vec![0.0; 2 * frames * LANES];
+    for l in 0..LANES {
+        input[l] = -0.01;
+    }
+    // Lane 2 gets a force no model survives.
+    input[2] = 1e300;
+    let mut out = vec![0.0; n_out * frames * LANES];
+    let mut tripped = [false; LANES];
+    for _ in 0..20 {
+        let t = lanes.process(frames, &input, &mut out);
+        for l in 0..LANES {
+            tripped[l] |= t[l];
+        }
+        input.fill(0.0);
+    }
+    assert_eq!(tripped, [false, false, true, false]);
+    assert!(lanes.is_tripped(2));
+    // The tripped lane is silent, the others ring.
+    let lane_peak = |l: usize, out: &[f64]| {
+        (0..n_out * frames)
+            .map(|i| out[i * LANES + l].abs())
+            .fold(0.0, f64::max)
+    };
+    assert_eq!(lane_peak(2, &out), 0.0);
+    assert!(lane_peak(0, &out) > 0.0);
+    lanes.reset_lane(2);
+    assert!(!lanes.is_tripped(2));
+    let mut x = vec![0.0; template.info().num_points];
+    let mut xp = vec![0.0; template.info().num_points];
+    lanes.lane_state(2, &mut x, &mut xp);
+    let mut rest = template.clone();
+    rest.reset();
+    assert_eq!(&x[..], &rest.positions()[..x.len()]);
+}
