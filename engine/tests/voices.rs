@@ -86,18 +86,44 @@ fn peak(x: &[f32]) -> f32 {
     x.iter().fold(0.0f32, |m, v| m.max(v.abs()))
 }
 
+/// A string macro struck directly: macros do not run in voice lanes, so its voices are
+/// whole engines.
+const STRING: &str = "\
+@s string 24 1. 0.1 0.0005 0. 0.
+@in1 frcInput [@s 0.3]
+@out1 posOutput [@s 0.7]
+";
+
+#[test]
+fn small_models_run_in_voice_lanes_and_macro_models_on_engines() {
+    use ressort_engine::instrument::voices::Copies;
+    let bank_of = |script: &str| {
+        let mut m = instrument::prepare("test", script, SR).unwrap();
+        m.set_voices(8);
+        m.bank.unwrap().copies
+    };
+    assert!(matches!(bank_of(STRUCK), Copies::Lanes(_)));
+    assert!(matches!(bank_of(DAMPED), Copies::Lanes(_)));
+    assert!(matches!(bank_of(STRING), Copies::Engines(_)));
+}
+
 #[test]
 fn a_chord_is_the_sum_of_its_notes() {
+    chord_is_the_sum_of_its_notes(STRUCK);
+    chord_is_the_sum_of_its_notes(STRING);
+}
+
+fn chord_is_the_sum_of_its_notes(script: &str) {
     let notes = [(0u32, 60u8), (12_000, 64), (24_001, 67)];
     let frames = 48_000;
     let chord: Vec<(u32, Event)> = notes
         .iter()
         .map(|&(t, n)| (t, Event::note_on(n, 0.9)))
         .collect();
-    let together = render(STRUCK, 8, quiet(), &chord, frames).left;
+    let together = render(script, 8, quiet(), &chord, frames).left;
     let mut sum = vec![0.0f64; frames];
     for &(t, n) in &notes {
-        let alone = render(STRUCK, 8, quiet(), &[(t, Event::note_on(n, 0.9))], frames).left;
+        let alone = render(script, 8, quiet(), &[(t, Event::note_on(n, 0.9))], frames).left;
         for (s, x) in sum.iter_mut().zip(&alone) {
             *s += *x as f64;
         }
@@ -122,10 +148,12 @@ fn a_chord_is_the_sum_of_its_notes() {
 fn a_bank_of_one_note_plays_the_monophonic_engine() {
     // One note from rest: a voice of the bank is the engine itself, to the bit.
     let note = [(100u32, Event::note_on(60, 0.8))];
-    let mono = render(STRUCK, 1, quiet(), &note, 24_000).left;
-    let poly = render(STRUCK, 4, quiet(), &note, 24_000).left;
-    assert!(peak(&mono) > 1e-3);
-    assert_eq!(mono, poly);
+    for script in [STRUCK, STRING] {
+        let mono = render(script, 1, quiet(), &note, 24_000).left;
+        let poly = render(script, 4, quiet(), &note, 24_000).left;
+        assert!(peak(&mono) > 1e-3);
+        assert_eq!(mono, poly);
+    }
 }
 
 #[test]

@@ -10,7 +10,7 @@ use super::envelope::StabilityEnvelope;
 use super::macros::MacroBinding;
 use super::prepare::Prepared;
 use super::{CHUNK, NUM_MACROS};
-use crate::{Engine, ScaleClass};
+use crate::{Engine, ParamId, ScaleClass};
 
 /// Smoothing time constant of the physical controls.
 const CONTROL_SMOOTHING_MS: f64 = 15.0;
@@ -124,6 +124,22 @@ impl Default for Gains {
 }
 
 /// The smoothed controls, advanced once per chunk.
+/// What the controls act on: a model's engine, or one voice of a bank.
+pub trait Controlled {
+    fn set_class_gain(&mut self, class: ScaleClass, gain: f64);
+    /// Ignores values the parameter cannot take (the controls only send finite ones).
+    fn set_param(&mut self, id: ParamId, value: f64);
+}
+
+impl Controlled for Engine {
+    fn set_class_gain(&mut self, class: ScaleClass, gain: f64) {
+        Engine::set_class_gain(self, class, gain);
+    }
+    fn set_param(&mut self, id: ParamId, value: f64) {
+        let _ = Engine::set_param(self, id, value);
+    }
+}
+
 /// The inputs of one voice's gains ([`Smoothed::tune_key`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TuneKey {
@@ -249,12 +265,17 @@ impl Smoothed {
     }
 
     /// Puts `gains` and the macro values on one engine (the model's, or a voice's).
-    pub fn set(&self, engine: &mut Engine, macros: &[Option<MacroBinding>], gains: &Gains) {
+    pub fn set(
+        &self,
+        engine: &mut impl Controlled,
+        macros: &[Option<MacroBinding>],
+        gains: &Gains,
+    ) {
         engine.set_class_gain(ScaleClass::Stiffness, gains.stiffness);
         engine.set_class_gain(ScaleClass::Damping, gains.damping);
         for (slot, binding) in macros.iter().enumerate() {
             if let Some(b) = binding {
-                let _ = engine.set_param(b.param, b.value_at(self.macros[slot].value));
+                engine.set_param(b.param, b.value_at(self.macros[slot].value));
             }
         }
     }

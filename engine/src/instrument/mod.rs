@@ -81,9 +81,11 @@ macro_rules! clamp_view {
 fn tune_voice(
     smoothed: &Smoothed,
     view: &ClampView<'_>,
-    v: &mut voices::Voice,
+    bank: &mut voices::VoiceBank,
+    i: usize,
     release: f64,
 ) -> Gains {
+    let v = &mut bank.voices[i];
     let z = if v.state == VoiceState::Released {
         release
     } else {
@@ -99,8 +101,8 @@ fn tune_voice(
         }
     }
     let g = smoothed.gains_offset(view, note_st, z, v.mod_k, v.mod_z);
-    smoothed.set(&mut v.engine, view.macros, &g);
     v.tuned = Some((key, g));
+    smoothed.set(&mut bank.copy(i), view.macros, &g);
     g
 }
 
@@ -346,13 +348,13 @@ impl Instrument {
         let mut shown = self.smoothed.gains(&view, 0.0, 1.0);
         self.smoothed.set(&mut m.engine, view.macros, &shown);
         let mut newest = 0;
-        for v in bank.voices.iter_mut() {
-            if v.state == VoiceState::Free {
+        for i in 0..bank.voices.len() {
+            if bank.voices[i].state == VoiceState::Free {
                 continue;
             }
-            let g = tune_voice(&self.smoothed, &view, v, release);
-            if v.started > newest {
-                newest = v.started;
+            let g = tune_voice(&self.smoothed, &view, bank, i, release);
+            if bank.voices[i].started > newest {
+                newest = bank.voices[i].started;
                 shown = g;
             }
         }
@@ -369,7 +371,7 @@ impl Instrument {
         };
         let view = clamp_view!(m);
         let release = 16f64.powf(self.controls.release);
-        self.gains = tune_voice(&self.smoothed, &view, &mut bank.voices[i], release);
+        self.gains = tune_voice(&self.smoothed, &view, bank, i, release);
     }
 
     /// An expression event: MPE bend, pressure, note tuning, polyphonic modulation. Returns
@@ -744,9 +746,10 @@ impl Instrument {
                 );
                 bank.free_silent(len);
                 if let Some(w) = m.watcher.as_mut() {
-                    let positions = bank
-                        .newest()
-                        .map_or(m.engine.positions(), |v| v.engine.positions());
+                    let positions = match bank.newest() {
+                        Some(i) => bank.positions(i).0,
+                        None => m.engine.positions(),
+                    };
                     w.tick(len, positions, self.watching);
                 }
             } else {

@@ -13,9 +13,10 @@
 //! rest does not matter: gravity and contacts leave static offsets (a dropped mass lies on its
 //! triangle, away from where it started).
 
-use super::controls::{Gains, TuneKey};
+use super::controls::{Controlled, Gains, TuneKey};
 use super::CHUNK;
-use crate::Engine;
+use crate::lanes::{LaneEngine, LANES};
+use crate::{Engine, ParamId, ScaleClass};
 
 /// The fade-out of a stolen voice.
 pub const STEAL_FADE_MS: f64 = 5.0;
@@ -36,13 +37,10 @@ pub enum VoiceState {
     Fading,
 }
 
-/// One copy of the model.
+/// One voice: what it plays and how it sounds; its copy of the model is in
+/// [`VoiceBank`]'s [`Copies`].
 #[derive(Clone, Debug)]
 pub struct Voice {
-    pub engine: Engine,
-    /// Planar scratch like the model's: inputs, then outputs, [`CHUNK`] samples per channel.
-    pub inputs: Vec<f64>,
-    pub outputs: Vec<f64>,
     pub state: VoiceState,
     pub note: u8,
     pub channel: u8,
@@ -82,10 +80,57 @@ pub struct Ended {
     pub voice_id: Option<i32>,
 }
 
+/// The voices' copies of the model: one engine each, or voice lanes (voice i is lane i mod
+/// [`LANES`] of group i / [`LANES`]) for the models [`LaneEngine::supports`].
+#[derive(Clone, Debug)]
+pub enum Copies {
+    Engines(Vec<Engine>),
+    Lanes(Vec<LaneEngine>),
+}
+
+/// Where the controls of one voice go: its engine, or its lane.
+#[derive(Debug)]
+pub enum VoiceCopy<'a> {
+    Engine(&'a mut Engine),
+    Lane(&'a mut LaneEngine, usize),
+}
+
+impl Controlled for VoiceCopy<'_> {
+    fn set_class_gain(&mut self, class: ScaleClass, gain: f64) {
+        match self {
+            VoiceCopy::Engine(e) => e.set_class_gain(class, gain),
+            VoiceCopy::Lane(g, l) => g.set_class_gain(*l, class, gain),
+        }
+    }
+    fn set_param(&mut self, id: ParamId, value: f64) {
+        let _ = match self {
+            VoiceCopy::Engine(e) => e.set_param(id, value),
+            VoiceCopy::Lane(g, _) => g.set_param(id, value),
+        };
+    }
+}
+
+/// Voice `i`'s positions into `x` (and its delayed positions into `xp` for lanes; an
+/// engine's stay where they are).
+fn lane_positions(copies: &Copies, i: usize, x: &mut [f64], xp: &mut [f64]) {
+    match copies {
+        Copies::Engines(e) => x.copy_from_slice(e[i].positions()),
+        Copies::Lanes(g) => g[i / LANES].lane_state(i % LANES, x, xp),
+    }
+}
+
 /// The voices of one prepared model.
 #[derive(Clone, Debug)]
 pub struct VoiceBank {
     pub voices: Vec<Voice>,
+    pub copies: Copies,
+    /// Planar scratch like the model's (inputs, then outputs, [`CHUNK`] samples per channel),
+    /// [`LANES`] values per sample with lanes.
+    inputs: Vec<f64>,
+    outputs: Vec<f64>,
+    /// A lane's positions and delayed positions, copied out.
+    x: Vec<f64>,
+    xp: Vec<f64>,
     /// How many voices may sound at once (the Voices setting); the rest of the capacity
     /// holds stolen voices while they fade.
     pub limit: usize,
@@ -113,10 +158,12 @@ impl VoiceBank {
         let mut engine = template.clone();
         engine.reset();
         let last = engine.positions().to_vec();
+        let points = last.len();
+        let (copies, width) = match LaneEngine::new(&engine) {
+            Some(group) => (Copies::Lanes(vec![group; capacity.div_ceil(LANES)]), LANES),
+            None => (Copies::Engines(vec![engine; capacity]), 1),
+        };
         let voice = Voice {
-            engine,
-            inputs: vec![0.0; n_in * CHUNK],
-            outputs: vec![0.0; n_out.max(1) * CHUNK],
             state: VoiceState::Free,
             note: 0,
             channel: 0,
@@ -139,6 +186,11 @@ impl VoiceBank {
         };
         VoiceBank {
             voices: vec![voice; capacity],
+            copies,
+            inputs: vec![0.0; n_in * CHUNK * width],
+            outputs: vec![0.0; n_out.max(1) * CHUNK * width],
+            x: vec![0.0; points],
+            xp: vec![0.0; points],
             limit,
             clock: 0,
             sustain: false,
@@ -158,11 +210,40 @@ impl VoiceBank {
     }
 
     /// The most recently started voice that is not free.
-    pub fn newest(&self) -> Option<&Voice> {
+    pub fn newest(&self) -> Option<usize> {
         self.voices
             .iter()
-            .filter(|v| v.state != VoiceState::Free)
-            .max_by_key(|v| v.started)
+            .enumerate()
+            .filter(|(_, v)| v.state != VoiceState::Free)
+            .max_by_key(|(_, v)| v.started)
+            .map(|(i, _)| i)
+    }
+
+    /// The controls of voice `i`'s copy of the model.
+    pub fn copy(&mut self, i: usize) -> VoiceCopy<'_> {
+        match &mut self.copies {
+            Copies::Engines(e) => VoiceCopy::Engine(&mut e[i]),
+            Copies::Lanes(g) => VoiceCopy::Lane(&mut g[i / LANES], i % LANES),
+        }
+    }
+
+    /// Voice `i`'s positions and delayed positions. Realtime-safe.
+    pub fn positions(&mut self, i: usize) -> (&[f64], &[f64]) {
+        match &self.copies {
+            Copies::Engines(e) => (e[i].positions(), e[i].delayed_positions()),
+            Copies::Lanes(g) => {
+                g[i / LANES].lane_state(i % LANES, &mut self.x, &mut self.xp);
+                (&self.x, &self.xp)
+            }
+        }
+    }
+
+    /// Voice `i`'s copy at the model's initial state.
+    fn reset_copy(&mut self, i: usize) {
+        match &mut self.copies {
+            Copies::Engines(e) => e[i].reset(),
+            Copies::Lanes(g) => g[i / LANES].reset_lane(i % LANES),
+        }
     }
 
     /// Starts a note: a free voice (the quietest sounding one is stolen when `limit` sound),
@@ -198,8 +279,14 @@ impl VoiceBank {
             }
         };
         self.clock += 1;
+        self.reset_copy(slot);
+        lane_positions(
+            &self.copies,
+            slot,
+            &mut self.voices[slot].last,
+            &mut self.xp,
+        );
         let v = &mut self.voices[slot];
-        v.engine.reset();
         v.state = VoiceState::Held;
         v.note = note;
         v.channel = channel;
@@ -214,7 +301,6 @@ impl VoiceBank {
         v.started = self.clock;
         v.quiet = 0;
         v.level = f64::INFINITY;
-        v.last.copy_from_slice(v.engine.positions());
         v.gain = 1.0;
         v.fade_step = 0.0;
         v.strike = strike;
@@ -350,56 +436,116 @@ impl VoiceBank {
         strike_force: f64,
         pressure: Option<(usize, f64)>,
     ) -> bool {
+        let n_in = inputs.len() / len.max(1);
+        let n_out = outputs.len() / len.max(1);
         let mut tripped = false;
-        for i in 0..self.voices.len() {
-            if self.voices[i].state == VoiceState::Free {
-                continue;
-            }
-            let v = &mut self.voices[i];
-            let n_in = inputs.len() / len.max(1);
-            let vin = &mut v.inputs[..inputs.len()];
-            vin.copy_from_slice(inputs);
-            if v.strike != 0.0 {
-                if let Some(k) = note_input.filter(|k| *k < n_in) {
-                    vin[k * len] += v.strike * strike_force;
-                }
-                v.strike = 0.0;
-            }
-            if let Some((k, gain)) = pressure.filter(|(k, _)| *k < n_in) {
-                let add = v.pressure * gain;
-                if add != 0.0 {
-                    vin[k * len..(k + 1) * len]
-                        .iter_mut()
-                        .for_each(|x| *x += add);
-                }
-            }
-            let vout = &mut v.outputs[..outputs.len()];
-            let report = v.engine.process(len, vin, vout);
-            if report.tripped || v.engine.is_tripped() {
-                tripped = true;
-                self.end(i);
-                continue;
-            }
-            let v = &mut self.voices[i];
-            if v.state == VoiceState::Fading {
-                let n_out = outputs.len() / len.max(1);
-                for n in 0..len {
-                    v.gain -= v.fade_step;
-                    let g = v.gain.max(0.0);
-                    for c in 0..n_out {
-                        outputs[c * len + n] += v.outputs[c * len + n] * g;
+        // Out of `self` while the voices are mixed and freed (an empty Vec does not allocate).
+        let mut copies = std::mem::replace(&mut self.copies, Copies::Engines(Vec::new()));
+        match &mut copies {
+            Copies::Engines(engines) => {
+                for i in 0..self.voices.len() {
+                    if self.voices[i].state == VoiceState::Free {
+                        continue;
                     }
+                    let vin = &mut self.inputs[..inputs.len()];
+                    vin.copy_from_slice(inputs);
+                    voice_inputs(
+                        &mut self.voices[i],
+                        vin,
+                        len,
+                        1,
+                        0,
+                        note_input,
+                        strike_force,
+                        pressure,
+                    );
+                    let vout = &mut self.outputs[..outputs.len()];
+                    let report = engines[i].process(len, vin, vout);
+                    if report.tripped || engines[i].is_tripped() {
+                        tripped = true;
+                        self.end(i);
+                        continue;
+                    }
+                    self.mix(i, len, n_out, 1, 0, outputs);
                 }
-                if v.gain <= 0.0 {
-                    self.voices[i].state = VoiceState::Free;
-                }
-            } else {
-                for (o, x) in outputs.iter_mut().zip(&v.outputs[..]) {
-                    *o += x;
+            }
+            Copies::Lanes(groups) => {
+                for (g, group) in groups.iter_mut().enumerate() {
+                    let first = g * LANES;
+                    let last = (first + LANES).min(self.voices.len());
+                    if self.voices[first..last]
+                        .iter()
+                        .all(|v| v.state == VoiceState::Free)
+                    {
+                        continue;
+                    }
+                    // Every lane hears the host's inputs, plus its own strike and pressure.
+                    let vin = &mut self.inputs[..n_in * len * LANES];
+                    for (k, x) in inputs.iter().enumerate() {
+                        vin[k * LANES..(k + 1) * LANES].fill(*x);
+                    }
+                    for i in first..last {
+                        voice_inputs(
+                            &mut self.voices[i],
+                            vin,
+                            len,
+                            LANES,
+                            i - first,
+                            note_input,
+                            strike_force,
+                            pressure,
+                        );
+                    }
+                    let vout = &mut self.outputs[..n_out * len * LANES];
+                    let lane_tripped = group.process(len, vin, vout);
+                    for i in first..last {
+                        if self.voices[i].state == VoiceState::Free {
+                            continue;
+                        }
+                        let l = i - first;
+                        if lane_tripped[l] || group.is_tripped(l) {
+                            tripped = true;
+                            self.end(i);
+                            continue;
+                        }
+                        self.mix(i, len, n_out, LANES, l, outputs);
+                    }
                 }
             }
         }
+        self.copies = copies;
         tripped
+    }
+
+    /// Adds voice `i`'s outputs (lane `lane` of `width` in the scratch) to `outputs`, fading
+    /// a stolen voice out and freeing it at the end of its fade.
+    fn mix(
+        &mut self,
+        i: usize,
+        len: usize,
+        n_out: usize,
+        width: usize,
+        lane: usize,
+        outputs: &mut [f64],
+    ) {
+        let v = &mut self.voices[i];
+        let src = &self.outputs;
+        if v.state == VoiceState::Fading {
+            for n in 0..len {
+                v.gain -= v.fade_step;
+                let g = v.gain.max(0.0);
+                for c in 0..n_out {
+                    outputs[c * len + n] += src[(c * len + n) * width + lane] * g;
+                }
+            }
+            if v.gain <= 0.0 {
+                v.state = VoiceState::Free;
+            }
+        } else {
+            for (k, o) in outputs[..n_out * len].iter_mut().enumerate() {
+                *o += src[k * width + lane];
+            }
+        }
     }
 
     /// Measures every sounding voice's motion after a span of `len` samples and frees the
@@ -415,8 +561,13 @@ impl VoiceBank {
                 v.quiet = 0;
                 continue;
             }
-            let x = v.engine.positions();
-            let xp = v.engine.delayed_positions();
+            let (x, xp): (&[f64], &[f64]) = match &self.copies {
+                Copies::Engines(e) => (e[i].positions(), e[i].delayed_positions()),
+                Copies::Lanes(g) => {
+                    g[i / LANES].lane_state(i % LANES, &mut self.x, &mut self.xp);
+                    (&self.x, &self.xp)
+                }
+            };
             let mut level: f64 = 0.0;
             for ((x, xp), last) in x.iter().zip(xp).zip(v.last.iter_mut()) {
                 level = level.max((x - xp).abs()).max((x - *last).abs());
@@ -430,6 +581,40 @@ impl VoiceBank {
                 }
             } else {
                 v.quiet = 0;
+            }
+        }
+    }
+}
+
+/// Adds voice `v`'s strike (on the note input's first sample) and pressure (on every sample of
+/// the `~pressure` input) to lane `lane` of `width` of the planar inputs `vin`, and consumes
+/// the strike.
+#[allow(clippy::too_many_arguments)]
+fn voice_inputs(
+    v: &mut Voice,
+    vin: &mut [f64],
+    len: usize,
+    width: usize,
+    lane: usize,
+    note_input: Option<usize>,
+    strike_force: f64,
+    pressure: Option<(usize, f64)>,
+) {
+    let n_in = vin.len() / (len * width).max(1);
+    if v.state == VoiceState::Free {
+        return;
+    }
+    if v.strike != 0.0 {
+        if let Some(k) = note_input.filter(|k| *k < n_in) {
+            vin[k * len * width + lane] += v.strike * strike_force;
+        }
+        v.strike = 0.0;
+    }
+    if let Some((k, gain)) = pressure.filter(|(k, _)| *k < n_in) {
+        let add = v.pressure * gain;
+        if add != 0.0 {
+            for n in 0..len {
+                vin[(k * len + n) * width + lane] += add;
             }
         }
     }
