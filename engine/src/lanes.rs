@@ -44,6 +44,8 @@ pub struct LaneEngine {
     x: Vec<Lanes>,
     xp: Vec<Lanes>,
     f: Vec<Lanes>,
+    /// Positions at the last [`LaneEngine::motion`].
+    last: Vec<Lanes>,
     params_dirty: bool,
     gains_dirty: [bool; LANES],
     samples_since_reset: [u64; LANES],
@@ -91,6 +93,7 @@ impl LaneEngine {
             x: vec![zero; n],
             xp: vec![zero; n],
             f: vec![zero; n],
+            last: vec![zero; n],
             params_dirty: true,
             gains_dirty: [true; LANES],
             samples_since_reset: [0; LANES],
@@ -156,6 +159,7 @@ impl LaneEngine {
             x[lane] = p.x[i];
             xp[lane] = p.xp[i];
             f[lane] = p.f[i];
+            self.last[i][lane] = p.x[i];
         }
         self.samples_since_reset[lane] = 0;
         self.tripped[lane] = false;
@@ -176,6 +180,21 @@ impl LaneEngine {
         for (o, v) in xp.iter_mut().zip(&self.xp) {
             *o = v[lane];
         }
+    }
+
+    /// How far each lane moved: the largest distance any point moved in the last sample or
+    /// since the last call, per lane (the voice bank's rest detection). Realtime-safe.
+    pub fn motion(&mut self) -> [f64; LANES] {
+        let mut level = [0.0f64; LANES];
+        for ((x, xp), last) in self.x.iter().zip(&self.xp).zip(&mut self.last) {
+            for l in 0..LANES {
+                level[l] = level[l]
+                    .max((x[l] - xp[l]).abs())
+                    .max((x[l] - last[l]).abs());
+                last[l] = x[l];
+            }
+        }
+        level
     }
 
     /// Re-evaluates the arguments and coefficients after a parameter or gain change.
@@ -298,77 +317,64 @@ impl LaneEngine {
         let it = &self.template.interactions;
         let args = &self.args[..];
         let (x, xp, f) = (&self.x[..], &self.xp[..], &mut self.f[..]);
-        apply(&it.linear, x, xp, f, |i, l, dx, dv| {
-            let c = &it.linear.cols;
-            laws::spring_damper(dx, dv, args[c[0] + i][l], args[c[1] + i][l])
-        });
-        apply(&it.contact, x, xp, f, |i, l, dx, dv| {
-            let c = &it.contact.cols;
-            laws::contact(
-                dx,
-                dv,
-                args[c[0] + i][l],
-                args[c[1] + i][l],
-                args[c[2] + i][l],
-            )
-        });
-        apply(&it.nl_contact, x, xp, f, |i, l, dx, dv| {
-            let c = &it.nl_contact.cols;
-            laws::nl_contact(
-                dx,
-                dv,
-                args[c[0] + i][l],
-                args[c[1] + i][l],
-                args[c[2] + i][l],
-                args[c[3] + i][l],
-                args[c[4] + i][l],
-            )
-        });
-        apply(&it.nl_spring2, x, xp, f, |i, l, dx, dv| {
-            let c = &it.nl_spring2.cols;
-            laws::nl_spring2(
-                dx,
-                dv,
-                args[c[0] + i][l],
-                args[c[1] + i][l],
-                args[c[2] + i][l],
-            )
-        });
-        apply(&it.nl_spring3, x, xp, f, |i, l, dx, dv| {
-            let c = &it.nl_spring3.cols;
-            laws::nl_spring3(
-                dx,
-                dv,
-                args[c[0] + i][l],
-                args[c[1] + i][l],
-                args[c[2] + i][l],
-            )
-        });
-        apply(&it.nl_spring_damper, x, xp, f, |i, l, dx, dv| {
-            let c = &it.nl_spring_damper.cols;
-            laws::nl_spring_damper(
-                dx,
-                dv,
-                args[c[0] + i][l],
-                args[c[1] + i][l],
-                args[c[2] + i][l],
-                args[c[3] + i][l],
-            )
-        });
-        apply(&it.pluck, x, xp, f, |i, l, dx, dv| {
-            let c = &it.pluck.cols;
-            laws::nl_pluck(
-                dx,
-                dv,
-                args[c[0] + i][l],
-                args[c[1] + i][l],
-                args[c[2] + i][l],
-            )
-        });
-        apply(&it.bow, x, xp, f, |i, l, _dx, dv| {
-            let c = &it.bow.cols;
-            laws::nl_bow(dv, args[c[0] + i][l], args[c[1] + i][l], args[c[2] + i][l])
-        });
+        // A group's argument column c, sliced to the group's length.
+        let col = |g: &Group, c: usize| &args[g.cols[c]..g.cols[c] + g.len()];
+        let g = &it.linear;
+        if g.len() > 0 {
+            let (k, z) = (col(g, 0), col(g, 1));
+            apply(g, x, xp, f, |i, l, dx, dv| {
+                laws::spring_damper(dx, dv, k[i][l], z[i][l])
+            });
+        }
+        let g = &it.contact;
+        if g.len() > 0 {
+            let (k, z, t) = (col(g, 0), col(g, 1), col(g, 2));
+            apply(g, x, xp, f, |i, l, dx, dv| {
+                laws::contact(dx, dv, k[i][l], z[i][l], t[i][l])
+            });
+        }
+        let g = &it.nl_contact;
+        if g.len() > 0 {
+            let (s, c, k, z, t) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3), col(g, 4));
+            apply(g, x, xp, f, |i, l, dx, dv| {
+                laws::nl_contact(dx, dv, s[i][l], c[i][l], k[i][l], z[i][l], t[i][l])
+            });
+        }
+        let g = &it.nl_spring2;
+        if g.len() > 0 {
+            let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
+            apply(g, x, xp, f, |i, l, dx, dv| {
+                laws::nl_spring2(dx, dv, k[i][l], q[i][l], z[i][l])
+            });
+        }
+        let g = &it.nl_spring3;
+        if g.len() > 0 {
+            let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
+            apply(g, x, xp, f, |i, l, dx, dv| {
+                laws::nl_spring3(dx, dv, k[i][l], q[i][l], z[i][l])
+            });
+        }
+        let g = &it.nl_spring_damper;
+        if g.len() > 0 {
+            let (s, c, k, z) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3));
+            apply(g, x, xp, f, |i, l, dx, dv| {
+                laws::nl_spring_damper(dx, dv, s[i][l], c[i][l], k[i][l], z[i][l])
+            });
+        }
+        let g = &it.pluck;
+        if g.len() > 0 {
+            let (k, sc, z) = (col(g, 0), col(g, 1), col(g, 2));
+            apply(g, x, xp, f, |i, l, dx, dv| {
+                laws::nl_pluck(dx, dv, k[i][l], sc[i][l], z[i][l])
+            });
+        }
+        let g = &it.bow;
+        if g.len() > 0 {
+            let (z, sc, sm) = (col(g, 0), col(g, 1), col(g, 2));
+            apply(g, x, xp, f, |i, l, _dx, dv| {
+                laws::nl_bow(dv, z[i][l], sc[i][l], sm[i][l])
+            });
+        }
         for r in &self.template.force_inputs {
             let ch = r.channel as usize;
             let fi = &mut f[r.index as usize];

@@ -551,7 +551,22 @@ impl VoiceBank {
     /// Measures every sounding voice's motion after a span of `len` samples and frees the
     /// ones that have stayed silent long enough. Realtime-safe.
     pub fn free_silent(&mut self, len: usize) {
+        let mut levels = [0.0; LANES];
         for i in 0..self.voices.len() {
+            // With lanes, a group's four levels at once, when its first voice comes up (the
+            // positions the group last saw are its own, not the voices' `last`).
+            if let Copies::Lanes(groups) = &mut self.copies {
+                if i % LANES == 0 {
+                    let first = i;
+                    let last = (i + LANES).min(self.voices.len());
+                    if self.voices[first..last]
+                        .iter()
+                        .any(|v| matches!(v.state, VoiceState::Held | VoiceState::Released))
+                    {
+                        levels = groups[i / LANES].motion();
+                    }
+                }
+            }
             let v = &mut self.voices[i];
             if !matches!(v.state, VoiceState::Held | VoiceState::Released) {
                 continue;
@@ -561,18 +576,18 @@ impl VoiceBank {
                 v.quiet = 0;
                 continue;
             }
-            let (x, xp): (&[f64], &[f64]) = match &self.copies {
-                Copies::Engines(e) => (e[i].positions(), e[i].delayed_positions()),
-                Copies::Lanes(g) => {
-                    g[i / LANES].lane_state(i % LANES, &mut self.x, &mut self.xp);
-                    (&self.x, &self.xp)
+            let level = match &self.copies {
+                Copies::Engines(e) => {
+                    let (x, xp) = (e[i].positions(), e[i].delayed_positions());
+                    let mut level: f64 = 0.0;
+                    for ((x, xp), last) in x.iter().zip(xp).zip(v.last.iter_mut()) {
+                        level = level.max((x - xp).abs()).max((x - *last).abs());
+                        *last = *x;
+                    }
+                    level
                 }
+                Copies::Lanes(_) => levels[i % LANES],
             };
-            let mut level: f64 = 0.0;
-            for ((x, xp), last) in x.iter().zip(xp).zip(v.last.iter_mut()) {
-                level = level.max((x - xp).abs()).max((x - *last).abs());
-                *last = *x;
-            }
             v.level = level;
             if level < FREE_LEVEL {
                 v.quiet += len as u64;
