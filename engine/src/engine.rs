@@ -31,6 +31,8 @@ pub(crate) struct Points {
     pub x: Vec<f64>,
     pub xp: Vec<f64>,
     pub f: Vec<f64>,
+    /// Link forces of the longest chain of any interaction group ([`Group::chains`]).
+    pub s: Vec<f64>,
 }
 
 /// Stage 2 a: single mass-type elements, points `0..len`.
@@ -327,11 +329,45 @@ pub(crate) struct Group {
     pub a: Vec<u32>,
     pub b: Vec<u32>,
     pub cols: Vec<usize>,
+    /// Chains, in list order: runs of at least [`MIN_CHAIN`] links at positions
+    /// `start..start + len` that join consecutive points, link j = (q + j, q + j + 1) — a
+    /// string or a mesh row written element by element. See [`Group::apply`].
+    pub chains: Vec<(u32, u32)>,
 }
+
+/// The shortest run of links [`Group::apply`] runs as a chain.
+pub(crate) const MIN_CHAIN: usize = 4;
 
 impl Group {
     pub fn len(&self) -> usize {
         self.a.len()
+    }
+
+    /// Finds the chains (done once, when the model is compiled).
+    pub fn find_chains(&mut self) {
+        self.chains.clear();
+        let n = self.len();
+        let mut i = 0;
+        while i < n {
+            let mut end = i;
+            while end < n
+                && self.b[end] == self.a[end] + 1
+                && (end == i || self.a[end] == self.a[end - 1] + 1)
+            {
+                end += 1;
+            }
+            if end - i >= MIN_CHAIN {
+                self.chains.push((i as u32, (end - i) as u32));
+                i = end;
+            } else {
+                i += 1;
+            }
+        }
+    }
+
+    /// The longest chain's length.
+    pub fn longest_chain(&self) -> usize {
+        self.chains.iter().map(|c| c.1 as usize).max().unwrap_or(0)
     }
 
     #[inline(always)]
@@ -340,22 +376,63 @@ impl Group {
     }
 
     /// Applies `law(i, Δx, Δv)` to every pair with the convention of spec §1.3:
-    /// F₁ −= f, F₂ += f.
+    /// F₁ −= f, F₂ += f, link by link in list order.
+    ///
+    /// A chain (links (q + j, q + j + 1), j = 0..m) runs as two contiguous loops that
+    /// vectorise: the forces s_j, then every point's sum. Point q + j (0 < j < m) receives
+    /// +s_{j−1} and then −s_j and nothing else within the chain, so
+    /// F ← (F + s_{j−1}) − s_j is the link-by-link scatter's arithmetic exactly; the
+    /// scatter's store-to-load chain through consecutive points is gone.
     #[inline(always)]
     fn apply(&self, p: &mut Points, law: impl Fn(usize, f64, f64) -> f64) {
         let n = self.len();
         let (a, b) = (&self.a[..n], &self.b[..n]);
         // Local slices: the stores to `f` cannot move the arrays, so their pointers and
         // lengths stay in registers.
-        let (x, xp, f) = (&p.x[..], &p.xp[..], &mut p.f[..]);
-        for i in 0..n {
-            let (ia, ib) = (a[i] as usize, b[i] as usize);
-            let dx = x[ia] - x[ib];
-            let dv = (x[ia] - xp[ia]) - (x[ib] - xp[ib]);
-            let force = law(i, dx, dv);
-            f[ia] -= force;
-            f[ib] += force;
+        let (x, xp, f, scratch) = (&p.x[..], &p.xp[..], &mut p.f[..], &mut p.s[..]);
+        let mut i = 0;
+        for &(start, len) in &self.chains {
+            let (start, m) = (start as usize, len as usize);
+            scatter(i, &a[i..start], &b[i..start], x, xp, f, &law);
+            let q = a[start] as usize;
+            let (xs, xps) = (&x[q..q + m + 1], &xp[q..q + m + 1]);
+            let s = &mut scratch[..m];
+            for j in 0..m {
+                let dx = xs[j] - xs[j + 1];
+                let dv = (xs[j] - xps[j]) - (xs[j + 1] - xps[j + 1]);
+                s[j] = law(start + j, dx, dv);
+            }
+            let fs = &mut f[q..q + m + 1];
+            fs[0] -= s[0];
+            for j in 1..m {
+                fs[j] = (fs[j] + s[j - 1]) - s[j];
+            }
+            fs[m] += s[m - 1];
+            i = start + m;
         }
+        scatter(i, &a[i..], &b[i..], x, xp, f, &law);
+    }
+}
+
+/// Links `first..first + a.len()` of a group, one by one: F₁ −= f, F₂ += f.
+#[inline(always)]
+fn scatter(
+    first: usize,
+    a: &[u32],
+    b: &[u32],
+    x: &[f64],
+    xp: &[f64],
+    f: &mut [f64],
+    law: &impl Fn(usize, f64, f64) -> f64,
+) {
+    let b = &b[..a.len()];
+    for k in 0..a.len() {
+        let (ia, ib) = (a[k] as usize, b[k] as usize);
+        let dx = x[ia] - x[ib];
+        let dv = (x[ia] - xp[ia]) - (x[ib] - xp[ib]);
+        let force = law(first + k, dx, dv);
+        f[ia] -= force;
+        f[ib] += force;
     }
 }
 
@@ -381,6 +458,20 @@ pub(crate) struct Interactions {
 }
 
 impl Interactions {
+    /// Every group, for the compiler's passes.
+    pub fn groups_mut(&mut self) -> [&mut Group; 8] {
+        [
+            &mut self.linear,
+            &mut self.contact,
+            &mut self.nl_contact,
+            &mut self.nl_spring2,
+            &mut self.nl_spring3,
+            &mut self.nl_spring_damper,
+            &mut self.pluck,
+            &mut self.bow,
+        ]
+    }
+
     /// Most models use two or three of the eight laws; an empty one costs one test (its
     /// argument columns are not even sliced).
     #[inline(always)]

@@ -65,18 +65,25 @@ impl<'a> Cx<'a> {
             .iter()
             .map(|r| params.values[r.index as usize])
             .collect();
+        let mut interactions = bound.interactions;
+        let mut longest_chain = 0;
+        for g in interactions.groups_mut() {
+            g.find_chains();
+            longest_chain = longest_chain.max(g.longest_chain());
+        }
         let mut engine = Engine {
             info,
             points: Points {
                 x: vec![0.0; total],
                 xp: vec![0.0; total],
                 f: vec![0.0; total],
+                s: vec![0.0; longest_chain],
             },
             args: self.args,
             singles: bound.singles,
             macros: bound.macros,
             proxies,
-            interactions: bound.interactions,
+            interactions,
             avatars: avatars.into_iter().map(|(_, route)| route).collect(),
             audio_params: params.audio,
             audio_defaults,
