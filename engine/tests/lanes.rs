@@ -108,12 +108,27 @@ fn lanes_equal_plain(
     assert!(loudest > 1e-6, "the model hardly moved: {loudest}");
 }
 
+/// An element-by-element string: its links form a chain (`Group::apply`).
+fn chain_string() -> String {
+    let mut text = String::from("@g0 ground 0.\n@g1 ground 0.\n");
+    for i in 0..24 {
+        text += &format!("@m{i} mass 1. 0. 0.\n");
+    }
+    text += "@l0 springDamper @g0 @m0 0.1 0.001\n";
+    for i in 0..23 {
+        text += &format!("@l{} springDamper @m{i} @m{} 0.1 0.001\n", i + 1, i + 1);
+    }
+    text += "@l24 springDamper @m23 @g1 0.1 0.001\n@in1 frcInput @m5\n@out1 posOutput @m17\n";
+    text
+}
+
 #[test]
 fn each_lane_is_a_plain_engine_bit_for_bit() {
     let k = [1.0, 0.5, 1.7, 2.3];
     let z = [1.0, 2.0, 0.6, 1.3];
     let strike = [-0.01, -0.02, 0.015, -0.005];
     lanes_equal_plain(&spec(MIXED), 48_000.0, k, z, strike);
+    lanes_equal_plain(&spec(&chain_string()), 48_000.0, k, z, strike);
     lanes_equal_plain(&preset("drunk-triangles.mdl"), 48_000.0, k, z, strike);
     lanes_equal_plain(
         &preset("drunk-triangles.mdl"),
