@@ -46,6 +46,8 @@ pub struct LaneEngine {
     f: Vec<Lanes>,
     /// Positions at the last [`LaneEngine::motion`].
     last: Vec<Lanes>,
+    /// Link forces of the longest chain (see `Group::apply`).
+    chain: Vec<Lanes>,
     params_dirty: bool,
     gains_dirty: [bool; LANES],
     samples_since_reset: [u64; LANES],
@@ -78,6 +80,7 @@ impl LaneEngine {
         let slots = template.args.len();
         // Slots no binding writes keep the values the compiler gave them.
         let args = template.args.iter().map(|&v| [v; LANES]).collect();
+        let chain_len = template.points.s.len();
         let singles = template.singles.len();
         let zero = [0.0; LANES];
         let mut lanes = LaneEngine {
@@ -94,6 +97,7 @@ impl LaneEngine {
             xp: vec![zero; n],
             f: vec![zero; n],
             last: vec![zero; n],
+            chain: vec![zero; chain_len],
             params_dirty: true,
             gains_dirty: [true; LANES],
             samples_since_reset: [0; LANES],
@@ -316,62 +320,67 @@ impl LaneEngine {
         // Stage 4: the interactions, one loop per law, then the force inputs.
         let it = &self.template.interactions;
         let args = &self.args[..];
-        let (x, xp, f) = (&self.x[..], &self.xp[..], &mut self.f[..]);
+        let (x, xp, f, chain) = (
+            &self.x[..],
+            &self.xp[..],
+            &mut self.f[..],
+            &mut self.chain[..],
+        );
         // A group's argument column c, sliced to the group's length.
         let col = |g: &Group, c: usize| &args[g.cols[c]..g.cols[c] + g.len()];
         let g = &it.linear;
         if g.len() > 0 {
             let (k, z) = (col(g, 0), col(g, 1));
-            apply(g, x, xp, f, |i, l, dx, dv| {
+            apply(g, x, xp, f, chain, |i, l, dx, dv| {
                 laws::spring_damper(dx, dv, k[i][l], z[i][l])
             });
         }
         let g = &it.contact;
         if g.len() > 0 {
             let (k, z, t) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, |i, l, dx, dv| {
+            apply(g, x, xp, f, chain, |i, l, dx, dv| {
                 laws::contact(dx, dv, k[i][l], z[i][l], t[i][l])
             });
         }
         let g = &it.nl_contact;
         if g.len() > 0 {
             let (s, c, k, z, t) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3), col(g, 4));
-            apply(g, x, xp, f, |i, l, dx, dv| {
+            apply(g, x, xp, f, chain, |i, l, dx, dv| {
                 laws::nl_contact(dx, dv, s[i][l], c[i][l], k[i][l], z[i][l], t[i][l])
             });
         }
         let g = &it.nl_spring2;
         if g.len() > 0 {
             let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, |i, l, dx, dv| {
+            apply(g, x, xp, f, chain, |i, l, dx, dv| {
                 laws::nl_spring2(dx, dv, k[i][l], q[i][l], z[i][l])
             });
         }
         let g = &it.nl_spring3;
         if g.len() > 0 {
             let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, |i, l, dx, dv| {
+            apply(g, x, xp, f, chain, |i, l, dx, dv| {
                 laws::nl_spring3(dx, dv, k[i][l], q[i][l], z[i][l])
             });
         }
         let g = &it.nl_spring_damper;
         if g.len() > 0 {
             let (s, c, k, z) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3));
-            apply(g, x, xp, f, |i, l, dx, dv| {
+            apply(g, x, xp, f, chain, |i, l, dx, dv| {
                 laws::nl_spring_damper(dx, dv, s[i][l], c[i][l], k[i][l], z[i][l])
             });
         }
         let g = &it.pluck;
         if g.len() > 0 {
             let (k, sc, z) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, |i, l, dx, dv| {
+            apply(g, x, xp, f, chain, |i, l, dx, dv| {
                 laws::nl_pluck(dx, dv, k[i][l], sc[i][l], z[i][l])
             });
         }
         let g = &it.bow;
         if g.len() > 0 {
             let (z, sc, sm) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, |i, l, _dx, dv| {
+            apply(g, x, xp, f, chain, |i, l, _dx, dv| {
                 laws::nl_bow(dv, z[i][l], sc[i][l], sm[i][l])
             });
         }
@@ -463,31 +472,69 @@ impl LaneEngine {
 }
 
 /// `law(i, lane, Δx, Δv)` on every pair of a group and every lane, with the convention of
-/// spec §1.3: F₁ −= f, F₂ += f.
+/// spec §1.3: F₁ −= f, F₂ += f, link by link; a chain as `Group::apply` runs it (its forces,
+/// then every point's sum: the same arithmetic), with `scratch` for its forces.
 #[inline(always)]
 fn apply(
     g: &Group,
     x: &[Lanes],
     xp: &[Lanes],
     f: &mut [Lanes],
+    scratch: &mut [Lanes],
     law: impl Fn(usize, usize, f64, f64) -> f64,
 ) {
     let n = g.len();
     let (a, b) = (&g.a[..n], &g.b[..n]);
-    for i in 0..n {
-        let (ia, ib) = (a[i] as usize, b[i] as usize);
-        let (xa, xb, xpa, xpb) = (x[ia], x[ib], xp[ia], xp[ib]);
-        let force: Lanes = std::array::from_fn(|l| {
-            let dx = xa[l] - xb[l];
-            let dv = (xa[l] - xpa[l]) - (xb[l] - xpb[l]);
-            law(i, l, dx, dv)
-        });
+    let mut i = 0;
+    let mut c = 0;
+    loop {
+        let (next, m) = match g.chains.get(c) {
+            Some(&(start, len)) => (start as usize, len as usize),
+            None => (n, 0),
+        };
+        for k in i..next {
+            let (ia, ib) = (a[k] as usize, b[k] as usize);
+            let (xa, xb, xpa, xpb) = (x[ia], x[ib], xp[ia], xp[ib]);
+            let force: Lanes = std::array::from_fn(|l| {
+                let dx = xa[l] - xb[l];
+                let dv = (xa[l] - xpa[l]) - (xb[l] - xpb[l]);
+                law(k, l, dx, dv)
+            });
+            for l in 0..LANES {
+                f[ia][l] -= force[l];
+            }
+            for l in 0..LANES {
+                f[ib][l] += force[l];
+            }
+        }
+        if m == 0 {
+            break;
+        }
+        let q = a[next] as usize;
+        let (xs, xps) = (&x[q..q + m + 1], &xp[q..q + m + 1]);
+        let s = &mut scratch[..m];
+        for j in 0..m {
+            let (xa, xb, xpa, xpb) = (xs[j], xs[j + 1], xps[j], xps[j + 1]);
+            s[j] = std::array::from_fn(|l| {
+                let dx = xa[l] - xb[l];
+                let dv = (xa[l] - xpa[l]) - (xb[l] - xpb[l]);
+                law(next + j, l, dx, dv)
+            });
+        }
+        let fs = &mut f[q..q + m + 1];
         for l in 0..LANES {
-            f[ia][l] -= force[l];
+            fs[0][l] -= s[0][l];
+        }
+        for j in 1..m {
+            for l in 0..LANES {
+                fs[j][l] = (fs[j][l] + s[j - 1][l]) - s[j][l];
+            }
         }
         for l in 0..LANES {
-            f[ib][l] += force[l];
+            fs[m][l] += s[m - 1][l];
         }
+        i = next + m;
+        c += 1;
     }
 }
 
