@@ -329,10 +329,11 @@ pub(crate) struct Group {
     pub a: Vec<u32>,
     pub b: Vec<u32>,
     pub cols: Vec<usize>,
-    /// Chains, in list order: runs of at least [`MIN_CHAIN`] links at positions
-    /// `start..start + len` that join consecutive points, link j = (q + j, q + j + 1) — a
-    /// string or a mesh row written element by element. See [`Group::apply`].
-    pub chains: Vec<(u32, u32)>,
+    /// Bands, in list order: runs of at least [`MIN_CHAIN`] links at positions
+    /// `start..start + len` with link j = (q + j, q + j + d), as (start, len, d) — a string
+    /// or a mesh row written element by element (d = 1), a mesh's links between rows
+    /// (d = its width). See [`Group::apply`].
+    pub chains: Vec<(u32, u32, u32)>,
 }
 
 /// The shortest run of links [`Group::apply`] runs as a chain.
@@ -343,21 +344,23 @@ impl Group {
         self.a.len()
     }
 
-    /// Finds the chains (done once, when the model is compiled).
+    /// Finds the bands (done once, when the model is compiled).
     pub fn find_chains(&mut self) {
         self.chains.clear();
         let n = self.len();
         let mut i = 0;
         while i < n {
+            let d = self.b[i].wrapping_sub(self.a[i]);
             let mut end = i;
             while end < n
-                && self.b[end] == self.a[end] + 1
+                && d >= 1
+                && self.b[end].wrapping_sub(self.a[end]) == d
                 && (end == i || self.a[end] == self.a[end - 1] + 1)
             {
                 end += 1;
             }
             if end - i >= MIN_CHAIN {
-                self.chains.push((i as u32, (end - i) as u32));
+                self.chains.push((i as u32, (end - i) as u32, d));
                 i = end;
             } else {
                 i += 1;
@@ -378,11 +381,12 @@ impl Group {
     /// Applies `law(i, Δx, Δv)` to every pair with the convention of spec §1.3:
     /// F₁ −= f, F₂ += f, link by link in list order.
     ///
-    /// A chain (links (q + j, q + j + 1), j = 0..m) runs as two contiguous loops that
-    /// vectorise: the forces s_j, then every point's sum. Point q + j (0 < j < m) receives
-    /// +s_{j−1} and then −s_j and nothing else within the chain, so
-    /// F ← (F + s_{j−1}) − s_j is the link-by-link scatter's arithmetic exactly; the
-    /// scatter's store-to-load chain through consecutive points is gone.
+    /// A band (links (q + j, q + j + d), j = 0..m) runs as contiguous loops that vectorise:
+    /// the forces s_j, then every point's sum. Point q + t receives +s_{t−d} (as the second
+    /// end of link t − d, when d ≤ t < m + d) and then −s_t (as the first end of link t, when
+    /// t < m), in that order in the list and nothing else within the band, so
+    /// F ← (F + s_{t−d}) − s_t is the link-by-link scatter's arithmetic exactly; the
+    /// scatter's store-to-load chain through shared points is gone.
     #[inline(always)]
     fn apply(&self, p: &mut Points, law: impl Fn(usize, f64, f64) -> f64) {
         let n = self.len();
@@ -391,23 +395,32 @@ impl Group {
         // lengths stay in registers.
         let (x, xp, f, scratch) = (&p.x[..], &p.xp[..], &mut p.f[..], &mut p.s[..]);
         let mut i = 0;
-        for &(start, len) in &self.chains {
-            let (start, m) = (start as usize, len as usize);
+        for &(start, len, d) in &self.chains {
+            let (start, m, d) = (start as usize, len as usize, d as usize);
             scatter(i, &a[i..start], &b[i..start], x, xp, f, &law);
             let q = a[start] as usize;
-            let (xs, xps) = (&x[q..q + m + 1], &xp[q..q + m + 1]);
+            let (xa, xb) = (&x[q..q + m], &x[q + d..q + d + m]);
+            let (xpa, xpb) = (&xp[q..q + m], &xp[q + d..q + d + m]);
             let s = &mut scratch[..m];
             for j in 0..m {
-                let dx = xs[j] - xs[j + 1];
-                let dv = (xs[j] - xps[j]) - (xs[j + 1] - xps[j + 1]);
+                let dx = xa[j] - xb[j];
+                let dv = (xa[j] - xpa[j]) - (xb[j] - xpb[j]);
                 s[j] = law(start + j, dx, dv);
             }
-            let fs = &mut f[q..q + m + 1];
-            fs[0] -= s[0];
-            for j in 1..m {
-                fs[j] = (fs[j] + s[j - 1]) - s[j];
+            let fs = &mut f[q..q + m + d];
+            for t in 0..m.min(d) {
+                fs[t] -= s[t];
             }
-            fs[m] += s[m - 1];
+            if m > d {
+                let (both, s_before) = (&mut fs[d..m], &s[..m - d]);
+                let s_now = &s[d..m];
+                for t in 0..m - d {
+                    both[t] = (both[t] + s_before[t]) - s_now[t];
+                }
+            }
+            for t in m.max(d)..m + d {
+                fs[t] += s[t - d];
+            }
             i = start + m;
         }
         scatter(i, &a[i..], &b[i..], x, xp, f, &law);

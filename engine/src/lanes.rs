@@ -472,7 +472,7 @@ impl LaneEngine {
 }
 
 /// `law(i, lane, Δx, Δv)` on every pair of a group and every lane, with the convention of
-/// spec §1.3: F₁ −= f, F₂ += f, link by link; a chain as `Group::apply` runs it (its forces,
+/// spec §1.3: F₁ −= f, F₂ += f, link by link; a band as `Group::apply` runs it (its forces,
 /// then every point's sum: the same arithmetic), with `scratch` for its forces.
 #[inline(always)]
 fn apply(
@@ -488,9 +488,9 @@ fn apply(
     let mut i = 0;
     let mut c = 0;
     loop {
-        let (next, m) = match g.chains.get(c) {
-            Some(&(start, len)) => (start as usize, len as usize),
-            None => (n, 0),
+        let (next, m, d) = match g.chains.get(c) {
+            Some(&(start, len, d)) => (start as usize, len as usize, d as usize),
+            None => (n, 0, 0),
         };
         for k in i..next {
             let (ia, ib) = (a[k] as usize, b[k] as usize);
@@ -511,27 +511,30 @@ fn apply(
             break;
         }
         let q = a[next] as usize;
-        let (xs, xps) = (&x[q..q + m + 1], &xp[q..q + m + 1]);
         let s = &mut scratch[..m];
         for j in 0..m {
-            let (xa, xb, xpa, xpb) = (xs[j], xs[j + 1], xps[j], xps[j + 1]);
+            let (xa, xb, xpa, xpb) = (x[q + j], x[q + d + j], xp[q + j], xp[q + d + j]);
             s[j] = std::array::from_fn(|l| {
                 let dx = xa[l] - xb[l];
                 let dv = (xa[l] - xpa[l]) - (xb[l] - xpb[l]);
                 law(next + j, l, dx, dv)
             });
         }
-        let fs = &mut f[q..q + m + 1];
-        for l in 0..LANES {
-            fs[0][l] -= s[0][l];
-        }
-        for j in 1..m {
+        let fs = &mut f[q..q + m + d];
+        for t in 0..m.min(d) {
             for l in 0..LANES {
-                fs[j][l] = (fs[j][l] + s[j - 1][l]) - s[j][l];
+                fs[t][l] -= s[t][l];
             }
         }
-        for l in 0..LANES {
-            fs[m][l] += s[m - 1][l];
+        for t in d..m {
+            for l in 0..LANES {
+                fs[t][l] = (fs[t][l] + s[t - d][l]) - s[t][l];
+            }
+        }
+        for t in m.max(d)..m + d {
+            for l in 0..LANES {
+                fs[t][l] += s[t - d][l];
+            }
         }
         i = next + m;
         c += 1;

@@ -122,6 +122,25 @@ fn chain_string() -> String {
     text
 }
 
+/// A 6 × 5 mesh written element by element: bands of links within rows and between them.
+fn element_mesh() -> String {
+    let (len, w) = (6, 5);
+    let mut text = String::from("@g ground 0.\n");
+    for i in 0..len * w {
+        text += &format!("@n{i} mass 1. 0. 0.\n");
+    }
+    for r in 0..len {
+        for c in 0..w - 1 {
+            let i = r * w + c;
+            text += &format!("@h{i} springDamper @n{i} @n{} 0.1 0.001\n", i + 1);
+        }
+    }
+    for i in 0..(len - 1) * w {
+        text += &format!("@v{i} springDamper @n{i} @n{} 0.1 0.001\n", i + w);
+    }
+    text + "@p springDamper @g @n0 0.1 0.001\n@in1 frcInput @n7\n@out1 posOutput @n22\n"
+}
+
 #[test]
 fn each_lane_is_a_plain_engine_bit_for_bit() {
     let k = [1.0, 0.5, 1.7, 2.3];
@@ -129,6 +148,7 @@ fn each_lane_is_a_plain_engine_bit_for_bit() {
     let strike = [-0.01, -0.02, 0.015, -0.005];
     lanes_equal_plain(&spec(MIXED), 48_000.0, k, z, strike);
     lanes_equal_plain(&spec(&chain_string()), 48_000.0, k, z, strike);
+    lanes_equal_plain(&spec(&element_mesh()), 48_000.0, k, z, strike);
     lanes_equal_plain(&preset("drunk-triangles.mdl"), 48_000.0, k, z, strike);
     lanes_equal_plain(
         &preset("drunk-triangles.mdl"),

@@ -6,8 +6,9 @@ pub(crate) mod mesh;
 mod tests {
     use crate::{compile, parse, CompileOptions};
 
-    /// A chain of links (a string written element by element, the rows of a mesh) runs as
-    /// two contiguous loops; the link-by-link scatter is its reference, bit for bit.
+    /// A band of links (a string written element by element, the rows of a mesh, the links
+    /// between its rows) runs as contiguous loops; the link-by-link scatter is its
+    /// reference, bit for bit.
     #[test]
     fn chains_equal_the_link_by_link_scatter() {
         let mut text = String::from("@g0 ground 0.\n@g1 ground 0.\n");
@@ -21,9 +22,34 @@ mod tests {
         // A link out of the chain between two runs, and a nonlinear law on the same points.
         text += "@x springDamper @m3 @m30 0.05 0.\n@c contact @m10 @m20 0.05 0.001 0.\n";
         text += "@l40 springDamper @m39 @g1 0.1 0.001\n@in1 frcInput @m7\n@out1 posOutput @m25\n";
-        let spec = parse(&text).spec.expect("parses");
+        chain_and_scatter_agree(&text, 1);
+        // A 7 × 6 mesh written element by element: rows (d = 1), then the links between rows
+        // (d = 6), with a corner pinned to a ground.
+        let (len, w) = (7, 6);
+        let mut text = String::from("@g ground 0.\n");
+        for i in 0..len * w {
+            text += &format!("@n{i} mass 1. 0. 0.\n");
+        }
+        let mut k = 0;
+        for r in 0..len {
+            for c in 0..w - 1 {
+                let i = r * w + c;
+                text += &format!("@h{k} springDamper @n{i} @n{} 0.1 0.001\n", i + 1);
+                k += 1;
+            }
+        }
+        for i in 0..(len - 1) * w {
+            text += &format!("@v{i} springDamper @n{i} @n{} 0.1 0.001\n", i + w);
+        }
+        text += "@p springDamper @g @n0 0.1 0.001\n@in1 frcInput @n8\n@out1 posOutput @n30\n";
+        chain_and_scatter_agree(&text, w as u32);
+    }
+
+    fn chain_and_scatter_agree(text: &str, widest: u32) {
+        let spec = parse(text).spec.expect("parses");
         let mut chained = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
-        assert!(!chained.interactions.linear.chains.is_empty());
+        let bands = &chained.interactions.linear.chains;
+        assert!(bands.iter().any(|b| b.2 == widest), "{bands:?}");
         let mut reference = chained.clone();
         reference.interactions.linear.chains.clear();
         let frames = 4096;
