@@ -1,5 +1,6 @@
 //! Kernels of the sample loop that live in their own files, each with its equation.
 
+pub(crate) mod links;
 pub(crate) mod mesh;
 
 #[cfg(test)]

@@ -1,0 +1,230 @@
+//! Stage 4 of spec §1.5: the interactions, one loop per law (spec §2.3–§2.6), over endpoint
+//! index arrays, with chains and bands of links run as contiguous loops.
+
+use crate::engine::Points;
+use crate::laws;
+
+/// Interactions of one law: endpoint index arrays and argument columns in `Engine::args`
+/// (column c of row i is `args[cols[c] + i]`).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Group {
+    pub a: Vec<u32>,
+    pub b: Vec<u32>,
+    pub cols: Vec<usize>,
+    /// Bands, in list order: runs of at least [`MIN_CHAIN`] links at positions
+    /// `start..start + len` with link j = (q + j, q + j + d), as (start, len, d) — a string
+    /// or a mesh row written element by element (d = 1), a mesh's links between rows
+    /// (d = its width). See [`Group::apply`].
+    pub chains: Vec<(u32, u32, u32)>,
+}
+
+/// The shortest run of links [`Group::apply`] runs as a chain.
+pub(crate) const MIN_CHAIN: usize = 4;
+
+impl Group {
+    pub fn len(&self) -> usize {
+        self.a.len()
+    }
+
+    /// Finds the bands (done once, when the model is compiled).
+    pub fn find_chains(&mut self) {
+        self.chains.clear();
+        let n = self.len();
+        let mut i = 0;
+        while i < n {
+            let d = self.b[i].wrapping_sub(self.a[i]);
+            let mut end = i;
+            while end < n
+                && d >= 1
+                && self.b[end].wrapping_sub(self.a[end]) == d
+                && (end == i || self.a[end] == self.a[end - 1] + 1)
+            {
+                end += 1;
+            }
+            if end - i >= MIN_CHAIN {
+                self.chains.push((i as u32, (end - i) as u32, d));
+                i = end;
+            } else {
+                i += 1;
+            }
+        }
+    }
+
+    /// The longest chain's length.
+    pub fn longest_chain(&self) -> usize {
+        self.chains.iter().map(|c| c.1 as usize).max().unwrap_or(0)
+    }
+
+    #[inline(always)]
+    fn col<'a>(&self, args: &'a [f64], c: usize) -> &'a [f64] {
+        &args[self.cols[c]..self.cols[c] + self.len()]
+    }
+
+    /// Applies `law(i, Δx, Δv)` to every pair with the convention of spec §1.3:
+    /// F₁ −= f, F₂ += f, link by link in list order.
+    ///
+    /// A band (links (q + j, q + j + d), j = 0..m) runs as contiguous loops that vectorise:
+    /// the forces s_j, then every point's sum. Point q + t receives +s_{t−d} (as the second
+    /// end of link t − d, when d ≤ t < m + d) and then −s_t (as the first end of link t, when
+    /// t < m), in that order in the list and nothing else within the band, so
+    /// F ← (F + s_{t−d}) − s_t is the link-by-link scatter's arithmetic exactly; the
+    /// scatter's store-to-load chain through shared points is gone.
+    #[inline(always)]
+    fn apply(&self, p: &mut Points, law: impl Fn(usize, f64, f64) -> f64) {
+        let n = self.len();
+        let (a, b) = (&self.a[..n], &self.b[..n]);
+        // Local slices: the stores to `f` cannot move the arrays, so their pointers and
+        // lengths stay in registers.
+        let (x, xp, f, scratch) = (&p.x[..], &p.xp[..], &mut p.f[..], &mut p.s[..]);
+        let mut i = 0;
+        for &(start, len, d) in &self.chains {
+            let (start, m, d) = (start as usize, len as usize, d as usize);
+            scatter(i, &a[i..start], &b[i..start], x, xp, f, &law);
+            let q = a[start] as usize;
+            let (xa, xb) = (&x[q..q + m], &x[q + d..q + d + m]);
+            let (xpa, xpb) = (&xp[q..q + m], &xp[q + d..q + d + m]);
+            let s = &mut scratch[..m];
+            for j in 0..m {
+                let dx = xa[j] - xb[j];
+                let dv = (xa[j] - xpa[j]) - (xb[j] - xpb[j]);
+                s[j] = law(start + j, dx, dv);
+            }
+            let fs = &mut f[q..q + m + d];
+            for t in 0..m.min(d) {
+                fs[t] -= s[t];
+            }
+            if m > d {
+                let (both, s_before) = (&mut fs[d..m], &s[..m - d]);
+                let s_now = &s[d..m];
+                for t in 0..m - d {
+                    both[t] = (both[t] + s_before[t]) - s_now[t];
+                }
+            }
+            for t in m.max(d)..m + d {
+                fs[t] += s[t - d];
+            }
+            i = start + m;
+        }
+        scatter(i, &a[i..], &b[i..], x, xp, f, &law);
+    }
+}
+
+/// Links `first..first + a.len()` of a group, one by one: F₁ −= f, F₂ += f.
+#[inline(always)]
+fn scatter(
+    first: usize,
+    a: &[u32],
+    b: &[u32],
+    x: &[f64],
+    xp: &[f64],
+    f: &mut [f64],
+    law: &impl Fn(usize, f64, f64) -> f64,
+) {
+    let b = &b[..a.len()];
+    for k in 0..a.len() {
+        let (ia, ib) = (a[k] as usize, b[k] as usize);
+        let dx = x[ia] - x[ib];
+        let dv = (x[ia] - xp[ia]) - (x[ib] - xp[ib]);
+        let force = law(first + k, dx, dv);
+        f[ia] -= force;
+        f[ib] += force;
+    }
+}
+
+/// Stage 4: every interaction, one loop per law.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Interactions {
+    /// spring, damper, springDamper: (K, Z).
+    pub linear: Group,
+    /// (K, Z, θ).
+    pub contact: Group,
+    /// (s, c, k, Z, θ).
+    pub nl_contact: Group,
+    /// (K, Q, Z).
+    pub nl_spring2: Group,
+    /// (K, Q, Z).
+    pub nl_spring3: Group,
+    /// (s, c, k, Z).
+    pub nl_spring_damper: Group,
+    /// (K, scale, Z).
+    pub pluck: Group,
+    /// (Z, scale, smooth).
+    pub bow: Group,
+}
+
+impl Interactions {
+    /// Every group, for the compiler's passes.
+    pub fn groups_mut(&mut self) -> [&mut Group; 8] {
+        [
+            &mut self.linear,
+            &mut self.contact,
+            &mut self.nl_contact,
+            &mut self.nl_spring2,
+            &mut self.nl_spring3,
+            &mut self.nl_spring_damper,
+            &mut self.pluck,
+            &mut self.bow,
+        ]
+    }
+
+    /// Most models use two or three of the eight laws; an empty one costs one test (its
+    /// argument columns are not even sliced).
+    #[inline(always)]
+    pub(crate) fn step(&self, p: &mut Points, args: &[f64]) {
+        let g = &self.linear;
+        if g.len() > 0 {
+            let (k, z) = (g.col(args, 0), g.col(args, 1));
+            g.apply(p, |i, dx, dv| laws::spring_damper(dx, dv, k[i], z[i]));
+        }
+        let g = &self.contact;
+        if g.len() > 0 {
+            let (k, z, t) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, dx, dv| laws::contact(dx, dv, k[i], z[i], t[i]));
+        }
+        let g = &self.nl_contact;
+        if g.len() > 0 {
+            let (s, c, k, z, t) = (
+                g.col(args, 0),
+                g.col(args, 1),
+                g.col(args, 2),
+                g.col(args, 3),
+                g.col(args, 4),
+            );
+            g.apply(p, |i, dx, dv| {
+                laws::nl_contact(dx, dv, s[i], c[i], k[i], z[i], t[i])
+            });
+        }
+        let g = &self.nl_spring2;
+        if g.len() > 0 {
+            let (k, q, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, dx, dv| laws::nl_spring2(dx, dv, k[i], q[i], z[i]));
+        }
+        let g = &self.nl_spring3;
+        if g.len() > 0 {
+            let (k, q, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, dx, dv| laws::nl_spring3(dx, dv, k[i], q[i], z[i]));
+        }
+        let g = &self.nl_spring_damper;
+        if g.len() > 0 {
+            let (s, c, k, z) = (
+                g.col(args, 0),
+                g.col(args, 1),
+                g.col(args, 2),
+                g.col(args, 3),
+            );
+            g.apply(p, |i, dx, dv| {
+                laws::nl_spring_damper(dx, dv, s[i], c[i], k[i], z[i])
+            });
+        }
+        let g = &self.pluck;
+        if g.len() > 0 {
+            let (k, sc, z) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, dx, dv| laws::nl_pluck(dx, dv, k[i], sc[i], z[i]));
+        }
+        let g = &self.bow;
+        if g.len() > 0 {
+            let (z, sc, sm) = (g.col(args, 0), g.col(args, 1), g.col(args, 2));
+            g.apply(p, |i, _dx, dv| laws::nl_bow(dv, z[i], sc[i], sm[i]));
+        }
+    }
+}
