@@ -428,6 +428,8 @@ pub enum HostEvent {
     /// A MIDI 1 pitch bend on MIDI channel `channel` (`value` in -1..=1, 0 = centre), sent as
     /// a 14-bit CLAP MIDI event.
     PitchBend { time: u32, value: f64, channel: u8 },
+    /// A MIDI 1 channel pressure on MIDI channel `channel` (`value` in 0..=1, sent as 0..=127).
+    ChannelPressure { time: u32, value: f64, channel: u8 },
     /// A MIDI 1 control change on channel 0 (`value` 0..=127), as a CLAP MIDI event.
     Controller { time: u32, cc: u8, value: u8 },
     /// A parameter change to a plain value.
@@ -440,6 +442,7 @@ impl HostEvent {
             HostEvent::NoteOn { time, .. }
             | HostEvent::NoteOff { time, .. }
             | HostEvent::PitchBend { time, .. }
+            | HostEvent::ChannelPressure { time, .. }
             | HostEvent::Controller { time, .. }
             | HostEvent::Param { time, .. } => time,
         }
@@ -451,6 +454,7 @@ impl HostEvent {
             HostEvent::NoteOn { time, .. }
             | HostEvent::NoteOff { time, .. }
             | HostEvent::PitchBend { time, .. }
+            | HostEvent::ChannelPressure { time, .. }
             | HostEvent::Controller { time, .. }
             | HostEvent::Param { time, .. } => *time = t,
         }
@@ -489,6 +493,15 @@ impl HostEvent {
             } => {
                 let v = Self::pitch_bend_14bit(value);
                 let data = [0xE0 | (channel & 0x0f), (v & 0x7f) as u8, (v >> 7) as u8];
+                buffer.push(&MidiEvent::new(time, 0, data));
+            }
+            HostEvent::ChannelPressure {
+                time,
+                value,
+                channel,
+            } => {
+                let v = (value.clamp(0.0, 1.0) * 127.0).round() as u8;
+                let data = [0xD0 | (channel & 0x0f), v & 0x7f, 0];
                 buffer.push(&MidiEvent::new(time, 0, data));
             }
             HostEvent::Controller { time, cc, value } => {
@@ -608,6 +621,15 @@ impl Score {
     /// A pitch bend on MIDI channel `channel`.
     pub fn pitch_bend_channel(self, frame: u32, value: f64, channel: u8) -> Score {
         self.event(HostEvent::PitchBend {
+            time: frame,
+            value,
+            channel,
+        })
+    }
+
+    /// A MIDI channel pressure (0..=1) on MIDI channel `channel`.
+    pub fn channel_pressure(self, frame: u32, value: f64, channel: u8) -> Score {
+        self.event(HostEvent::ChannelPressure {
             time: frame,
             value,
             channel,

@@ -239,6 +239,74 @@ fn an_mpe_bend_moves_only_its_channels_voice() {
 }
 
 /// A lightly damped oscillator struck directly: one clean partial per voice.
+/// MPE channel pressure presses only the voices of its channel: with `~pressure in1`, the
+/// pressed voice gets a sustained force, whose step response rings at that voice's pitch.
+/// The difference between a chord with and without pressure on one member channel is that
+/// voice's step response alone (FFT), with nothing at the other voice's pitch.
+#[test]
+fn mpe_channel_pressure_presses_only_its_channels_voice() {
+    use ressort_tests::{band_energy_share, cents, peak_frequency};
+    let frames = 48_000;
+    let script = format!("{DAMPED_SLOWLY}~pressure in1 0.001\n");
+    let settings = [
+        ("voices", json!({ "i32": 8 })),
+        ("output_gain", json!({ "f32": -12.0 })),
+        ("mpe", json!({ "bool": true })),
+        ("dc_filter", json!({ "bool": false })),
+    ];
+    let chord = Score::new()
+        .note_on_channel(0, 60, 0.9, 1)
+        .note_on_channel(0, 67, 0.9, 2);
+    let mut plugin = plugin_with_model("poly", &script, &settings);
+    let plain = render(&mut plugin, frames, &chord);
+    let mut plugin = plugin_with_model("poly", &script, &settings);
+    let pressed = render(
+        &mut plugin,
+        frames,
+        &chord.clone().channel_pressure(4_800, 1.0, 2),
+    );
+    let diff: Vec<f32> = pressed
+        .left
+        .iter()
+        .zip(&plain.left)
+        .map(|(a, b)| a - b)
+        .collect();
+    let alone = |key: u8| {
+        let mut p = plugin_with_model("poly", &script, &settings);
+        render(
+            &mut p,
+            frames,
+            &Score::new().note_on_channel(0, key, 0.9, 1),
+        )
+        .left
+    };
+    let (f60, f67) = (
+        peak_frequency(&alone(60), SR, 20.0, 20_000.0),
+        peak_frequency(&alone(67), SR, 20.0, 20_000.0),
+    );
+    let peak = diff.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+    let ring = peak_frequency(&diff[4_800..], SR, 20.0, 20_000.0);
+    let share60 = band_energy_share(&diff[4_800..], SR, f60 / 1.01, f60 * 1.01);
+    println!(
+        "pressure on channel 3: difference peak {peak:.2e}, rings at {ring:.2} Hz \
+         ({:+.2} ct from note 67), energy share at note 60 {share60:.2e}",
+        cents(ring, f67)
+    );
+    assert!(peak > 1e-4, "the pressure did not move anything ({peak:e})");
+    assert!(
+        cents(ring, f67).abs() < 5.0,
+        "the pressed voice is not note 67's"
+    );
+    assert!(
+        share60 < 1e-3,
+        "note 60's voice was pressed too ({share60:e})"
+    );
+    assert!(
+        diff[..4_800].iter().all(|v| *v == 0.0),
+        "pressure acted before it was sent"
+    );
+}
+
 const DAMPED_SLOWLY: &str = "\
 # A lightly damped oscillator (MPE tests).
 @o osc 1. 0.02 0.0002 0. 0.
