@@ -52,6 +52,18 @@ pub(crate) struct SingleMasses {
     pub cols: [usize; 4],
 }
 
+/// The coefficients (a, b, 1/M, g) of a single mass-type element from its M, K, Z and gravity
+/// (spec §2.1.2): a = 2 − (K+Z)/M, b = Z/M − 1. A ground is the M → ∞ limit (1, 0, 0, 0).
+/// Shared by the plain engine and the voice lanes, which must compute the same bits.
+#[inline]
+pub(crate) fn single_law(fixed: bool, m: f64, k: f64, z: f64, gravity: f64) -> [f64; 4] {
+    if fixed {
+        [1.0, 0.0, 0.0, 0.0]
+    } else {
+        [2.0 - (k + z) / m, z / m - 1.0, 1.0 / m, gravity]
+    }
+}
+
 impl SingleMasses {
     pub fn len(&self) -> usize {
         self.a.len()
@@ -60,20 +72,9 @@ impl SingleMasses {
     /// Recomputes the coefficients of point `i` from its arguments.
     #[inline]
     pub fn derive(&mut self, i: usize, args: &[f64]) {
-        if self.fixed[i] {
-            self.a[i] = 1.0;
-            self.b[i] = 0.0;
-            self.inv_m[i] = 0.0;
-            self.gravity[i] = 0.0;
-            return;
-        }
-        let m = args[self.cols[0] + i];
-        let k = args[self.cols[1] + i];
-        let z = args[self.cols[2] + i];
-        self.a[i] = 2.0 - (k + z) / m;
-        self.b[i] = z / m - 1.0;
-        self.inv_m[i] = 1.0 / m;
-        self.gravity[i] = args[self.cols[3] + i];
+        let arg = |c: usize| args[self.cols[c] + i];
+        [self.a[i], self.b[i], self.inv_m[i], self.gravity[i]] =
+            single_law(self.fixed[i], arg(0), arg(1), arg(2), arg(3));
     }
 
     #[inline(always)]

@@ -12,7 +12,7 @@
 //! Models with macros, connection points, position inputs or audio-rate parameters are not
 //! laned ([`LaneEngine::supports`]); they keep one [`Engine`] per voice.
 
-use crate::engine::{ArgClass, Group, NUM_ARG_CLASSES};
+use crate::engine::{single_law, ArgClass, Group, NUM_ARG_CLASSES};
 use crate::engine::{FLUSH_BELOW, FLUSH_INTERVAL};
 use crate::laws;
 use crate::spec::ScaleClass;
@@ -226,20 +226,13 @@ impl LaneEngine {
             }
             let s = &t.singles;
             for i in 0..s.len() {
-                if s.fixed[i] {
-                    self.a[i][l] = 1.0;
-                    self.b[i][l] = 0.0;
-                    self.inv_m[i][l] = 0.0;
-                    self.gravity[i][l] = 0.0;
-                    continue;
-                }
-                let m = self.args[s.cols[0] + i][l];
-                let k = self.args[s.cols[1] + i][l];
-                let z = self.args[s.cols[2] + i][l];
-                self.a[i][l] = 2.0 - (k + z) / m;
-                self.b[i][l] = z / m - 1.0;
-                self.inv_m[i][l] = 1.0 / m;
-                self.gravity[i][l] = self.args[s.cols[3] + i][l];
+                let arg = |c: usize| self.args[s.cols[c] + i][l];
+                [
+                    self.a[i][l],
+                    self.b[i][l],
+                    self.inv_m[i][l],
+                    self.gravity[i][l],
+                ] = single_law(s.fixed[i], arg(0), arg(1), arg(2), arg(3));
             }
             self.gains_dirty[l] = false;
         }

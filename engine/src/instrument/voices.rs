@@ -61,7 +61,7 @@ pub struct Voice {
     /// Samples spent below [`FREE_LEVEL`], and the last motion measured.
     quiet: u64,
     pub level: f64,
-    /// Every point's position at the last check.
+    /// Every point's position at the last check (voices on engines; a lane group keeps its own).
     last: Vec<f64>,
     /// Output gain (1 but while fading) and its step per sample.
     gain: f64,
@@ -107,15 +107,6 @@ impl Controlled for VoiceCopy<'_> {
             VoiceCopy::Engine(e) => e.set_param(id, value),
             VoiceCopy::Lane(g, _) => g.set_param(id, value),
         };
-    }
-}
-
-/// Voice `i`'s positions into `x` (and its delayed positions into `xp` for lanes; an
-/// engine's stay where they are).
-fn lane_positions(copies: &Copies, i: usize, x: &mut [f64], xp: &mut [f64]) {
-    match copies {
-        Copies::Engines(e) => x.copy_from_slice(e[i].positions()),
-        Copies::Lanes(g) => g[i / LANES].lane_state(i % LANES, x, xp),
     }
 }
 
@@ -280,12 +271,10 @@ impl VoiceBank {
         };
         self.clock += 1;
         self.reset_copy(slot);
-        lane_positions(
-            &self.copies,
-            slot,
-            &mut self.voices[slot].last,
-            &mut self.xp,
-        );
+        // The rest detection's reference (a lane group keeps its own).
+        if let Copies::Engines(e) = &self.copies {
+            self.voices[slot].last.copy_from_slice(e[slot].positions());
+        }
         let v = &mut self.voices[slot];
         v.state = VoiceState::Held;
         v.note = note;
