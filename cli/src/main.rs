@@ -20,7 +20,9 @@ mod report;
 
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use ressort_engine::{compile, parse_bytes, CompileOptions, Engine, InputUse, ModelSpec};
+use ressort_engine::{
+    compile, parse_bytes, CompileOptions, Engine, InputUse, ModelSpec, ScaleClass,
+};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -140,6 +142,11 @@ struct BenchArgs {
     /// (the plugin's polyphony, through its instrument).
     #[arg(long, value_name = "N")]
     voices: Option<usize>,
+    /// Measure what automation costs: the same model steady and with its Stiffness gain swept
+    /// (×0.5 to ×1, one cycle per second, a new value every 16 samples as the plugin's
+    /// smoother gives), in one run, and print both and their ratio.
+    #[arg(long, conflicts_with = "voices")]
+    sweep: bool,
 }
 
 /// Why a command failed: bad model (exit 1) or usage / I/O (exit 2). The message is printed
@@ -197,6 +204,64 @@ fn build(path: &Path, spec: &ModelSpec, sample_rate_hz: f64) -> Result<Engine, F
         }
         Failure::Model
     })
+}
+
+/// The strike `ressort bench` gives a model: −0.01 on its first input if that is a force.
+fn bench_strike(engine: &Engine, block: usize) -> Vec<f64> {
+    let mut first = vec![0.0; engine.info().num_inputs() * block];
+    if matches!(
+        engine.info().inputs.first().and_then(|u| u.first()),
+        Some(InputUse::Force(_))
+    ) {
+        first[0] = -0.01;
+    }
+    first
+}
+
+/// `ressort bench --sweep`: passes with the class gains still and with the Stiffness gain
+/// moving every 16 samples, alternated on one engine (reset between passes, so both run on
+/// the same memory) from the same struck start; the best pass of each kind is reported.
+fn bench_sweep(a: &BenchArgs, mut engine: Engine, compile_ms: f64) -> Result<(), Failure> {
+    const CHUNK: usize = 16;
+    const PASSES: usize = 3;
+    let total = ((a.seconds * a.sample_rate / PASSES as f64).round() as u64).max(CHUNK as u64);
+    let first = bench_strike(&engine, CHUNK);
+    let rest = vec![0.0; first.len()];
+    let mut out = vec![0.0; engine.info().num_outputs() * CHUNK];
+    let mut pass = |e: &mut Engine, sweep: bool| {
+        e.set_class_gain(ScaleClass::Stiffness, 1.0);
+        e.reset();
+        let t = Instant::now();
+        let mut done = 0u64;
+        while done < total {
+            if sweep {
+                let phase = std::f64::consts::TAU * done as f64 / a.sample_rate;
+                e.set_class_gain(ScaleClass::Stiffness, 0.75 + 0.25 * phase.cos());
+            }
+            e.process(CHUNK, if done == 0 { &first } else { &rest }, &mut out);
+            done += CHUNK as u64;
+        }
+        t.elapsed().as_secs_f64() * 1e9 / done as f64
+    };
+    let (mut steady, mut swept) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..PASSES {
+        steady = steady.min(pass(&mut engine, false));
+        swept = swept.min(pass(&mut engine, true));
+    }
+    eprintln!(
+        "{}: {PASSES} × {total} samples each at {} Hz in {CHUNK}-sample blocks, steady and with \
+         Stiffness swept",
+        a.model.display(),
+        a.sample_rate
+    );
+    println!(
+        "steady_ns_per_sample={steady:.3} sweep_ns_per_sample={swept:.3} sweep_cost={:.3}x \
+         points={} interactions={} compile_ms={compile_ms:.3}",
+        swept / steady,
+        engine.info().num_points,
+        engine.info().num_interactions
+    );
+    Ok(())
 }
 
 fn check(a: &CheckArgs) -> Result<(), Failure> {
@@ -482,17 +547,14 @@ fn bench(a: &BenchArgs) -> Result<(), Failure> {
     let mut engine = build(&a.model, &spec, a.sample_rate)?;
     let compile_ms = start.elapsed().as_secs_f64() * 1e3;
 
+    if a.sweep {
+        return bench_sweep(a, engine, compile_ms);
+    }
     let block = 64;
     let n_in = engine.info().num_inputs();
     let n_out = engine.info().num_outputs();
     let total = (a.seconds * a.sample_rate).round().max(1.0) as u64;
-    let mut first = vec![0.0; n_in * block];
-    if matches!(
-        engine.info().inputs.first().and_then(|u| u.first()),
-        Some(InputUse::Force(_))
-    ) {
-        first[0] = -0.01;
-    }
+    let first = bench_strike(&engine, block);
     let rest = vec![0.0; n_in * block];
     let mut out = vec![0.0; n_out * block];
     let t = Instant::now();

@@ -432,3 +432,40 @@ fn the_guides_modes_table_is_what_the_command_prints() {
         }
     }
 }
+
+#[test]
+fn bench_sweep_prints_steady_and_swept_costs() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(dir.path(), "s.mdl", STRING_1000);
+    let out = ressort(&["bench", model.to_str().unwrap(), "--seconds", "0.05", "--sweep"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let fields: Vec<(&str, f64)> = stdout
+        .lines()
+        .last()
+        .unwrap()
+        .split(' ')
+        .map(|kv| {
+            let (k, v) = kv.split_once('=').unwrap();
+            (k, v.trim_end_matches('x').parse().unwrap())
+        })
+        .collect();
+    let keys: Vec<&str> = fields.iter().map(|f| f.0).collect();
+    assert_eq!(
+        keys,
+        [
+            "steady_ns_per_sample",
+            "sweep_ns_per_sample",
+            "sweep_cost",
+            "points",
+            "interactions",
+            "compile_ms"
+        ]
+    );
+    assert!(fields.iter().all(|f| f.1.is_finite() && f.1 > 0.0), "{stdout}");
+    let ratio = fields[1].1 / fields[0].1;
+    assert!((fields[2].1 - ratio).abs() < 1e-2 * ratio, "{stdout}");
+    // `--sweep` measures one engine; a bank of voices is `--voices`.
+    let out = ressort(&["bench", model.to_str().unwrap(), "--sweep", "--voices", "2"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+}

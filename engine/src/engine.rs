@@ -17,6 +17,7 @@
 //! its own stencil kernel. Each interaction law has its own loop over endpoint index arrays.
 //! Names never reach this module's hot paths; there is no per-element `match`.
 
+use crate::control::{Changed, ControlArgs};
 use crate::expr::{ExprRef, Program};
 use crate::info::ModelInfo;
 use crate::laws;
@@ -468,9 +469,9 @@ pub struct Engine {
     pub(crate) stack: crate::expr::EvalStack,
     /// Current parameter values, by parameter id.
     pub(crate) params: Vec<f64>,
-    /// Arguments that depend on no audio-rate parameter: re-evaluated when a control
-    /// parameter or a class gain changes.
-    pub(crate) control_bindings: Vec<Binding>,
+    /// Arguments that depend on no audio-rate parameter: brought up to date at a block
+    /// boundary after a control parameter or a class gain changed.
+    pub(crate) control: ControlArgs,
     /// Arguments that depend on an audio-rate parameter: re-evaluated every sample.
     pub(crate) audio_bindings: Vec<Binding>,
     /// Single masses and proxies whose coefficients depend on audio-rate arguments.
@@ -828,16 +829,37 @@ impl Engine {
     /// coefficients. Runs at a block boundary, only after a change.
     fn refresh_control(&mut self) {
         let scale = self.class_factors();
-        for b in &self.control_bindings {
-            self.args[b.slot as usize] =
-                self.program.eval(b.expr, &self.params, &mut self.stack) * scale[b.class as usize];
-        }
+        let changed = self.control.refresh(
+            &self.program,
+            &self.params,
+            &mut self.stack,
+            &scale,
+            &mut self.args,
+        );
         self.refresh_audio_args(&scale);
-        for i in 0..self.singles.len() {
-            self.singles.derive(i, &self.args);
-        }
-        for i in 0..self.proxies.len() {
-            self.proxies.derive(i, &self.args);
+        match changed {
+            Changed::All => {
+                for i in 0..self.singles.len() {
+                    self.singles.derive(i, &self.args);
+                }
+                for i in 0..self.proxies.len() {
+                    self.proxies.derive(i, &self.args);
+                }
+            }
+            Changed::Some { proxies } => {
+                for &i in self.control.dirty_singles() {
+                    self.singles.derive(i as usize, &self.args);
+                }
+                // Audio-rate arguments follow the class factors too.
+                for &i in &self.audio_masses {
+                    self.singles.derive(i as usize, &self.args);
+                }
+                for i in 0..self.proxies.len() {
+                    if proxies || self.audio_proxies.contains(&(i as u32)) {
+                        self.proxies.derive(i, &self.args);
+                    }
+                }
+            }
         }
         self.params_dirty = false;
     }

@@ -418,6 +418,16 @@ impl Program {
         Ok(())
     }
 
+    /// The parameter slots `e` reads (repeated if it reads one twice).
+    pub(crate) fn params_read(&self, e: ExprRef) -> impl Iterator<Item = u32> + '_ {
+        self.ops[e.start as usize..(e.start + e.len) as usize]
+            .iter()
+            .filter_map(|op| match op {
+                Op::Param(i) => Some(*i),
+                _ => None,
+            })
+    }
+
     /// A stack with enough capacity for every expression of this program.
     pub(crate) fn new_stack(&self) -> EvalStack {
         EvalStack(Vec::with_capacity(self.max_stack.max(1)))

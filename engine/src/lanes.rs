@@ -205,7 +205,7 @@ impl LaneEngine {
     fn refresh(&mut self) {
         let t = &mut self.template;
         if self.params_dirty {
-            for bind in &t.control_bindings {
+            for bind in &t.control.bindings {
                 self.raw[bind.slot as usize] = t.program.eval(bind.expr, &t.params, &mut t.stack);
             }
             self.gains_dirty = [true; LANES];
@@ -220,7 +220,7 @@ impl LaneEngine {
             for (s, g) in scale.iter_mut().zip(self.gains[l]) {
                 *s *= g;
             }
-            for bind in &t.control_bindings {
+            for bind in &t.control.bindings {
                 let slot = bind.slot as usize;
                 self.args[slot][l] = self.raw[slot] * scale[bind.class as usize];
             }

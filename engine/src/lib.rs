@@ -22,6 +22,7 @@
 //! ```
 
 pub mod compile;
+mod control;
 pub mod engine;
 pub mod expr;
 pub mod generators;

@@ -9,6 +9,7 @@ use super::label_map::LabelMap;
 use super::labels::Params;
 use super::points::Numbering;
 use super::{CompileOptions, Rate};
+use crate::control::ControlArgs;
 use crate::engine::{ArgClass, Engine, Points, DEFAULT_POSITION_LIMIT, NUM_ARG_CLASSES};
 use crate::info::{ModelInfo, ParamInfo};
 use crate::motion::{MotionLayout, NamedBuffer};
@@ -71,6 +72,15 @@ impl<'a> Cx<'a> {
             g.find_chains();
             longest_chain = longest_chain.max(g.longest_chain());
         }
+        let control = ControlArgs::new(
+            self.control_bindings,
+            &self.program,
+            params.values.len(),
+            self.args.len(),
+            bound.singles.cols,
+            bound.singles.len(),
+            proxies.coord_slots.iter().flatten().copied(),
+        );
         let mut engine = Engine {
             info,
             points: Points {
@@ -94,7 +104,7 @@ impl<'a> Cx<'a> {
             program: self.program,
             stack,
             params: params.values,
-            control_bindings: self.control_bindings,
+            control,
             audio_bindings: self.audio_bindings,
             audio_masses: bound.audio_masses,
             audio_proxies: self.proxy_audio,
