@@ -437,7 +437,13 @@ fn the_guides_modes_table_is_what_the_command_prints() {
 fn bench_sweep_prints_steady_and_swept_costs() {
     let dir = tempfile::tempdir().unwrap();
     let model = write(dir.path(), "s.mdl", STRING_1000);
-    let out = ressort(&["bench", model.to_str().unwrap(), "--seconds", "0.05", "--sweep"]);
+    let out = ressort(&[
+        "bench",
+        model.to_str().unwrap(),
+        "--seconds",
+        "0.05",
+        "--sweep",
+    ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
     let fields: Vec<(&str, f64)> = stdout
@@ -462,7 +468,10 @@ fn bench_sweep_prints_steady_and_swept_costs() {
             "compile_ms"
         ]
     );
-    assert!(fields.iter().all(|f| f.1.is_finite() && f.1 > 0.0), "{stdout}");
+    assert!(
+        fields.iter().all(|f| f.1.is_finite() && f.1 > 0.0),
+        "{stdout}"
+    );
     let ratio = fields[1].1 / fields[0].1;
     assert!((fields[2].1 - ratio).abs() < 1e-2 * ratio, "{stdout}");
     // `--sweep` measures one engine; a bank of voices is `--voices`.

@@ -20,6 +20,7 @@
 use crate::control::{Changed, ControlArgs};
 use crate::expr::{ExprRef, Program};
 use crate::info::ModelInfo;
+pub(crate) use crate::kernels::masses::{single_law, SingleMasses};
 use crate::laws;
 use crate::motion::MotionStore;
 use crate::spec::ScaleClass;
@@ -34,69 +35,6 @@ pub(crate) struct Points {
     pub f: Vec<f64>,
     /// Link forces of the longest chain of any interaction group ([`Group::chains`]).
     pub s: Vec<f64>,
-}
-
-/// Stage 2 a: single mass-type elements, points `0..len`.
-///
-/// X[n+1] = a·X[n] + b·X[n−1] + (F − g)·(1/M), with a = 2 − (K+Z)/M and b = Z/M − 1 (spec
-/// §2.1.2; K = Z = 0 for `mass`, which gives 2X − X̃ + (F − g)/M, spec §2.1.1).
-#[derive(Clone, Debug, Default)]
-pub(crate) struct SingleMasses {
-    pub a: Vec<f64>,
-    pub b: Vec<f64>,
-    pub inv_m: Vec<f64>,
-    /// Per-step gravity force g (subtracted from F).
-    pub gravity: Vec<f64>,
-    /// Grounds: never move (cold, used by `derive`).
-    pub fixed: Vec<bool>,
-    /// Argument columns in `Engine::args`: M, K, Z, gravity.
-    pub cols: [usize; 4],
-}
-
-/// The coefficients (a, b, 1/M, g) of a single mass-type element from its M, K, Z and gravity
-/// (spec §2.1.2): a = 2 − (K+Z)/M, b = Z/M − 1. A ground is the M → ∞ limit (1, 0, 0, 0).
-/// Shared by the plain engine and the voice lanes, which must compute the same bits.
-#[inline]
-pub(crate) fn single_law(fixed: bool, m: f64, k: f64, z: f64, gravity: f64) -> [f64; 4] {
-    if fixed {
-        [1.0, 0.0, 0.0, 0.0]
-    } else {
-        [2.0 - (k + z) / m, z / m - 1.0, 1.0 / m, gravity]
-    }
-}
-
-impl SingleMasses {
-    pub fn len(&self) -> usize {
-        self.a.len()
-    }
-
-    /// Recomputes the coefficients of point `i` from its arguments.
-    #[inline]
-    pub fn derive(&mut self, i: usize, args: &[f64]) {
-        let arg = |c: usize| args[self.cols[c] + i];
-        [self.a[i], self.b[i], self.inv_m[i], self.gravity[i]] =
-            single_law(self.fixed[i], arg(0), arg(1), arg(2), arg(3));
-    }
-
-    #[inline(always)]
-    fn step(&self, p: &mut Points) {
-        let n = self.len();
-        let (x, xp, f) = (&mut p.x[..n], &mut p.xp[..n], &mut p.f[..n]);
-        // Every array sliced to n up front: no bounds checks, and no reloads of the vectors'
-        // pointers between the stores (this loop is inlined into the whole sample loop).
-        let (a, b, g, inv_m) = (
-            &self.a[..n],
-            &self.b[..n],
-            &self.gravity[..n],
-            &self.inv_m[..n],
-        );
-        for i in 0..n {
-            let next = a[i] * x[i] + b[i] * xp[i] + (f[i] - g[i]) * inv_m[i];
-            xp[i] = x[i];
-            x[i] = next;
-            f[i] = 0.0;
-        }
-    }
 }
 
 /// The argument slots of one macro in `Engine::args`: M, K, K2 (stiff strings), Z, Zo.
@@ -842,6 +780,7 @@ impl Engine {
                 for i in 0..self.singles.len() {
                     self.singles.derive(i, &self.args);
                 }
+                self.singles.classify();
                 for i in 0..self.proxies.len() {
                     self.proxies.derive(i, &self.args);
                 }
@@ -849,6 +788,9 @@ impl Engine {
             Changed::Some { proxies } => {
                 for &i in self.control.dirty_singles() {
                     self.singles.derive(i as usize, &self.args);
+                }
+                if !self.control.dirty_singles().is_empty() {
+                    self.singles.classify();
                 }
                 // Audio-rate arguments follow the class factors too.
                 for &i in &self.audio_masses {

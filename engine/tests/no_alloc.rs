@@ -57,7 +57,9 @@ fn main() {
     let mut audio_params_set = 0;
     for (name, spec) in reference::all() {
         // A clone, as voices and the plugin run: `clone` keeps lengths, not capacities.
-        let mut e = compile(&spec, &CompileOptions::at(48_000.0)).unwrap().clone();
+        let mut e = compile(&spec, &CompileOptions::at(48_000.0))
+            .unwrap()
+            .clone();
         let frames = 256;
         let in_ch = e.info().num_inputs();
         let out_ch = e.info().num_outputs();

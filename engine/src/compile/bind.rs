@@ -75,7 +75,10 @@ impl<'a> Cx<'a> {
             inv_m: vec![0.0; n_single],
             gravity: vec![0.0; n_single],
             fixed: vec![false; n_single],
+            audio: vec![false; n_single],
             cols,
+            runs: vec![(0, 0, false); n_single],
+            num_runs: 0,
         };
         let mut audio_masses = Vec::new();
         let zero = Expr::Num(0.0);
@@ -105,6 +108,7 @@ impl<'a> Cx<'a> {
             audio |= self.bind(g, gclass, cols[3] + row, i);
             if audio {
                 audio_masses.push(row as u32);
+                singles.audio[row] = true;
             }
             // Single masses are numbered first, in this order: row r is point r.
             let first = row as u32;

@@ -1,6 +1,7 @@
 //! Kernels of the sample loop that live in their own files, each with its equation.
 
 pub(crate) mod links;
+pub(crate) mod masses;
 pub(crate) mod mesh;
 
 #[cfg(test)]
@@ -44,6 +45,88 @@ mod tests {
         }
         text += "@p springDamper @g @n0 0.1 0.001\n@in1 frcInput @n8\n@out1 posOutput @n30\n";
         chain_and_scatter_agree(&text, w as u32);
+    }
+
+    /// Plain masses (a = 2, b = −1, g = +0) run their own loop; the general update is its
+    /// reference, bit for bit, also when a parameter turns a plain mass into an oscillator
+    /// and back, and with gravity and −0 gravity beside them.
+    #[test]
+    fn plain_masses_equal_the_general_update() {
+        let mut text = String::from(
+            "@K param 0.
+@g0 ground 0.
+",
+        );
+        for i in 0..30 {
+            text += &match i {
+                7 => "@m7 osc 1. K 0. 0. 0.
+"
+                .to_string(),
+                11 => "@m11 mass 2. 0.3 0. -0.
+"
+                .to_string(),
+                12 => "@m12 mass 2. 0.3 0. 0.001
+"
+                .to_string(),
+                20 => "@m20 ground 0.1
+"
+                .to_string(),
+                _ => format!(
+                    "@m{i} mass {}. 0. 0.
+",
+                    1 + i % 3
+                ),
+            };
+        }
+        text += "@l0 springDamper @g0 @m0 0.1 0.001
+";
+        for i in 0..29 {
+            text += &format!(
+                "@l{} springDamper @m{i} @m{} 0.1 0.001
+",
+                i + 1,
+                i + 1
+            );
+        }
+        text += "@in1 frcInput @m3
+@out1 posOutput @m25
+@out2 frcOutput @m11
+";
+        let spec = parse(&text).spec.expect("parses");
+        let mut fast = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
+        let runs = |e: &crate::Engine| e.singles.runs[..e.singles.num_runs].to_vec();
+        assert!(
+            runs(&fast).iter().any(|r| r.2 && r.1 > 4),
+            "{:?}",
+            runs(&fast)
+        );
+        let mut general = fast.clone();
+        let k = fast.param_id("K").unwrap();
+        let frames = 512;
+        let mut input = vec![0.0; frames];
+        input[0] = -0.01;
+        let (mut a, mut b) = (vec![0.0; 2 * frames], vec![0.0; 2 * frames]);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for (block, value) in [0.0, 0.02, 0.0, 0.05].into_iter().enumerate() {
+            fast.set_param(k, value).unwrap();
+            general.set_param(k, value).unwrap();
+            fast.apply_pending_changes();
+            general.apply_pending_changes();
+            // m7 is point 8 (the ground g0 is point 0).
+            let plain_osc = runs(&fast)
+                .iter()
+                .any(|r| r.2 && (r.0..r.0 + r.1).contains(&8));
+            assert_eq!(plain_osc, value == 0.0, "{:?}", runs(&fast));
+            let n = general.singles.len() as u32;
+            general.singles.runs[0] = (0, n, false);
+            general.singles.num_runs = 1;
+            fast.process(frames, &input, &mut a);
+            general.process(frames, &input, &mut b);
+            assert!(a.iter().any(|v| v.abs() > 1e-6));
+            assert_eq!(bits(&a), bits(&b), "block {block}");
+            assert_eq!(bits(fast.positions()), bits(general.positions()));
+            input[0] = 0.0;
+        }
     }
 
     fn chain_and_scatter_agree(text: &str, widest: u32) {
