@@ -803,6 +803,8 @@ impl Engine {
                 }
             }
         }
+        // Link arguments may have changed: which chains read one set of arguments.
+        self.interactions.find_uniform(&self.args);
         self.params_dirty = false;
     }
 

@@ -66,10 +66,15 @@ impl<'a> Cx<'a> {
             .iter()
             .map(|r| params.values[r.index as usize])
             .collect();
+        let mut audio_slots = vec![false; self.args.len()];
+        for b in &self.audio_bindings {
+            audio_slots[b.slot as usize] = true;
+        }
         let mut interactions = bound.interactions;
         let mut longest_chain = 0;
         for g in interactions.groups_mut() {
             g.find_chains();
+            g.mark_varying(&audio_slots);
             longest_chain = longest_chain.max(g.longest_chain());
         }
         let control = ControlArgs::new(

@@ -16,10 +16,19 @@ pub(crate) struct Group {
     /// or a mesh row written element by element (d = 1), a mesh's links between rows
     /// (d = its width). See [`Group::apply`].
     pub chains: Vec<(u32, u32, u32)>,
+    /// Per chain: every link's arguments are equal (column by column, bit for bit), so the
+    /// law reads the first link's and the loop streams no argument ([`Group::find_uniform`]).
+    pub uniform: Vec<bool>,
+    /// Per chain: an argument is audio-rate (it may change within a block): never uniform.
+    pub varying: Vec<bool>,
 }
 
 /// The shortest run of links [`Group::apply`] runs as a chain.
 pub(crate) const MIN_CHAIN: usize = 4;
+
+/// The shortest uniform chain that runs without argument streams: the compiler unrolls that
+/// loop further, so shorter ones (mesh rows) would run in its scalar remainder.
+const UNIFORM_MIN: usize = 64;
 
 impl Group {
     pub fn len(&self) -> usize {
@@ -47,6 +56,34 @@ impl Group {
             } else {
                 i += 1;
             }
+        }
+        self.uniform = vec![false; self.chains.len()];
+        self.varying = vec![false; self.chains.len()];
+    }
+
+    /// Marks the chains with an argument slot in `audio` (one flag per slot of the
+    /// engine's arguments) as varying. Done once, when the model is compiled.
+    pub fn mark_varying(&mut self, audio: &[bool]) {
+        for (c, &(start, len, _)) in self.chains.iter().enumerate() {
+            let range = start as usize..(start + len) as usize;
+            self.varying[c] = self
+                .cols
+                .iter()
+                .any(|&col| audio[col + range.start..col + range.end].contains(&true));
+        }
+    }
+
+    /// Recomputes which chains are uniform, after the control arguments changed. Never
+    /// allocates.
+    pub fn find_uniform(&mut self, args: &[f64]) {
+        for (c, &(start, len, _)) in self.chains.iter().enumerate() {
+            let range = start as usize..(start + len) as usize;
+            self.uniform[c] = !self.varying[c]
+                && self.cols.iter().all(|&col| {
+                    let v = &args[col + range.start..col + range.end];
+                    let first = v[0].to_bits();
+                    v.iter().all(|a| a.to_bits() == first)
+                });
         }
     }
 
@@ -77,17 +114,27 @@ impl Group {
         // lengths stay in registers.
         let (x, xp, f, scratch) = (&p.x[..], &p.xp[..], &mut p.f[..], &mut p.s[..]);
         let mut i = 0;
-        for &(start, len, d) in &self.chains {
+        for (c, &(start, len, d)) in self.chains.iter().enumerate() {
             let (start, m, d) = (start as usize, len as usize, d as usize);
+            let uniform = self.uniform.get(c).copied().unwrap_or(false);
             scatter(i, &a[i..start], &b[i..start], x, xp, f, &law);
             let q = a[start] as usize;
             let (xa, xb) = (&x[q..q + m], &x[q + d..q + d + m]);
             let (xpa, xpb) = (&xp[q..q + m], &xp[q + d..q + d + m]);
             let s = &mut scratch[..m];
-            for j in 0..m {
-                let dx = xa[j] - xb[j];
-                let dv = (xa[j] - xpa[j]) - (xb[j] - xpb[j]);
-                s[j] = law(start + j, dx, dv);
+            if uniform && m >= UNIFORM_MIN {
+                // Every link's arguments are the first link's: read once, outside the loop.
+                for j in 0..m {
+                    let dx = xa[j] - xb[j];
+                    let dv = (xa[j] - xpa[j]) - (xb[j] - xpb[j]);
+                    s[j] = law(start, dx, dv);
+                }
+            } else {
+                for j in 0..m {
+                    let dx = xa[j] - xb[j];
+                    let dv = (xa[j] - xpa[j]) - (xb[j] - xpb[j]);
+                    s[j] = law(start + j, dx, dv);
+                }
             }
             let fs = &mut f[q..q + m + d];
             for t in 0..m.min(d) {
@@ -165,6 +212,13 @@ impl Interactions {
             &mut self.pluck,
             &mut self.bow,
         ]
+    }
+
+    /// [`Group::find_uniform`] for every group.
+    pub fn find_uniform(&mut self, args: &[f64]) {
+        for g in self.groups_mut() {
+            g.find_uniform(args);
+        }
     }
 
     /// Most models use two or three of the eight laws; an empty one costs one test (its

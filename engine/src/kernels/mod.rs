@@ -129,6 +129,67 @@ mod tests {
         }
     }
 
+    /// A long chain whose links all read the same arguments runs without argument streams;
+    /// when a parameter makes one link differ it reads them link by link again. Both equal the
+    /// link-by-link scatter, bit for bit.
+    #[test]
+    fn uniform_chains_equal_the_link_by_link_scatter() {
+        let mut text = String::from(
+            "@K param 0.1
+@K2 param 0.1
+@g0 ground 0.
+@g1 ground 0.
+",
+        );
+        for i in 0..120 {
+            text += &format!(
+                "@m{i} mass 1. 0. 0.
+"
+            );
+        }
+        text += "@l0 springDamper @g0 @m0 K 0.001
+";
+        for i in 0..119 {
+            let k = if i == 60 { "K2" } else { "K" };
+            text += &format!(
+                "@l{} springDamper @m{i} @m{} {k} 0.001
+",
+                i + 1,
+                i + 1
+            );
+        }
+        text += "@l120 springDamper @m119 @g1 K 0.001
+@in1 frcInput @m7
+@out1 posOutput @m90
+";
+        let spec = parse(&text).spec.expect("parses");
+        let mut chained = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
+        let mut reference = chained.clone();
+        reference.interactions.linear.chains.clear();
+        reference.interactions.linear.uniform.clear();
+        let k2 = chained.param_id("K2").unwrap();
+        let frames = 1024;
+        let mut input = vec![0.0; frames];
+        input[0] = -0.01;
+        let (mut a, mut b) = (vec![0.0; frames], vec![0.0; frames]);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for (block, value) in [0.1, 0.15, 0.1].into_iter().enumerate() {
+            chained.set_param(k2, value).unwrap();
+            reference.set_param(k2, value).unwrap();
+            chained.apply_pending_changes();
+            let linear = &chained.interactions.linear;
+            assert_eq!(linear.chains.len(), 1, "{:?}", linear.chains);
+            assert!(linear.chains[0].1 as usize >= 64);
+            assert_eq!(linear.uniform, [value == 0.1], "block {block}");
+            chained.process(frames, &input, &mut a);
+            reference.process(frames, &input, &mut b);
+            assert!(a.iter().any(|v| v.abs() > 1e-6));
+            assert_eq!(bits(&a), bits(&b), "block {block}");
+            input[0] = 0.0;
+        }
+        assert_eq!(bits(chained.positions()), bits(reference.positions()));
+    }
+
     fn chain_and_scatter_agree(text: &str, widest: u32) {
         let spec = parse(text).spec.expect("parses");
         let mut chained = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
