@@ -29,15 +29,17 @@ pub(crate) enum Changed {
     /// Everything was evaluated (the first refresh).
     All,
     /// Only the singles in [`ControlArgs::dirty_singles`], and the connection points if
-    /// `proxies` is set.
-    Some { proxies: bool },
+    /// `proxies` is set. `values` tells whether a parameter moved an expression's value
+    /// (not only a class factor, which scales equal arguments to equal arguments).
+    Some { proxies: bool, values: bool },
 }
 
 /// The control bindings of a model and what their incremental refresh needs.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ControlArgs {
     pub bindings: Vec<Binding>,
-    /// Each bound slot's expression value, without its class factor (by slot).
+    /// Each bound slot's expression value, without its class factor (by slot; a slot no
+    /// binding writes holds its argument).
     raw: Vec<f64>,
     /// The bindings that read parameter p: `readers[reader_start[p]..reader_start[p + 1]]`.
     reader_start: Vec<u32>,
@@ -69,7 +71,7 @@ impl ControlArgs {
         bindings: Vec<Binding>,
         program: &Program,
         num_params: usize,
-        num_slots: usize,
+        args: &[f64],
         single_cols: [usize; 4],
         singles: usize,
         proxy_slots: impl Iterator<Item = usize>,
@@ -78,6 +80,7 @@ impl ControlArgs {
         let mut reads: Vec<Vec<u32>> = Vec::with_capacity(bindings.len());
         let mut rescale: [Vec<u32>; NUM_ARG_CLASSES] = Default::default();
         let mut rescale_derived: [Vec<u32>; NUM_ARG_CLASSES] = Default::default();
+        let num_slots = args.len();
         let mut slot_dep = vec![NO_DEP; num_slots];
         for col in single_cols {
             for i in 0..singles {
@@ -130,7 +133,8 @@ impl ControlArgs {
             "one binding per slot"
         );
         ControlArgs {
-            raw: vec![0.0; num_slots],
+            // Slots no binding writes keep the compiler's value.
+            raw: args.to_vec(),
             bindings,
             reader_start,
             readers,
@@ -145,6 +149,12 @@ impl ControlArgs {
             proxies_changed: false,
             fresh: true,
         }
+    }
+
+    /// Every slot's value before its class factor. Arguments of one class that are equal
+    /// here are equal whatever the factors.
+    pub fn raw(&self) -> &[f64] {
+        &self.raw
     }
 
     /// The singles whose arguments the last refresh changed.
@@ -177,12 +187,14 @@ impl ControlArgs {
             self.fresh = false;
             return Changed::All;
         }
+        let mut values = false;
         for p in 0..self.seen_params.len() {
             if params[p].to_bits() == self.seen_params[p].to_bits() {
                 continue;
             }
             self.seen_params[p] = params[p];
             let range = self.reader_start[p] as usize..self.reader_start[p + 1] as usize;
+            values |= !range.is_empty();
             for k in range {
                 let i = self.readers[k] as usize;
                 let b = self.bindings[i];
@@ -207,6 +219,7 @@ impl ControlArgs {
         }
         Changed::Some {
             proxies: self.proxies_changed,
+            values,
         }
     }
 

@@ -785,7 +785,7 @@ impl Engine {
                     self.proxies.derive(i, &self.args);
                 }
             }
-            Changed::Some { proxies } => {
+            Changed::Some { proxies, .. } => {
                 for &i in self.control.dirty_singles() {
                     self.singles.derive(i as usize, &self.args);
                 }
@@ -803,8 +803,11 @@ impl Engine {
                 }
             }
         }
-        // Link arguments may have changed: which chains read one set of arguments.
-        self.interactions.find_uniform(&self.args);
+        // Which chains read one set of arguments: compared before the class factors (one per
+        // column), so that a change of factor alone cannot change the answer.
+        if matches!(changed, Changed::All | Changed::Some { values: true, .. }) {
+            self.interactions.find_uniform(self.control.raw());
+        }
         self.params_dirty = false;
     }
 

@@ -67,21 +67,25 @@ impl<'a> Cx<'a> {
             .map(|r| params.values[r.index as usize])
             .collect();
         let mut audio_slots = vec![false; self.args.len()];
+        let mut slot_class = vec![u8::MAX; self.args.len()];
         for b in &self.audio_bindings {
             audio_slots[b.slot as usize] = true;
+        }
+        for b in self.control_bindings.iter().chain(&self.audio_bindings) {
+            slot_class[b.slot as usize] = b.class as u8;
         }
         let mut interactions = bound.interactions;
         let mut longest_chain = 0;
         for g in interactions.groups_mut() {
             g.find_chains();
-            g.mark_varying(&audio_slots);
+            g.mark_varying(&audio_slots, &slot_class);
             longest_chain = longest_chain.max(g.longest_chain());
         }
         let control = ControlArgs::new(
             self.control_bindings,
             &self.program,
             params.values.len(),
-            self.args.len(),
+            &self.args,
             bound.singles.cols,
             bound.singles.len(),
             proxies.coord_slots.iter().flatten().copied(),

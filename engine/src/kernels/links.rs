@@ -16,7 +16,8 @@ pub(crate) struct Group {
     /// or a mesh row written element by element (d = 1), a mesh's links between rows
     /// (d = its width). See [`Group::apply`].
     pub chains: Vec<(u32, u32, u32)>,
-    /// Per chain: every link's arguments are equal (column by column, bit for bit), so the
+    /// Per chain: every link's arguments are equal (column by column, bit for bit, before
+    /// the class factors), so the
     /// law reads the first link's and the loop streams no argument ([`Group::find_uniform`]).
     pub uniform: Vec<bool>,
     /// Per chain: an argument is audio-rate (it may change within a block): never uniform.
@@ -61,26 +62,30 @@ impl Group {
         self.varying = vec![false; self.chains.len()];
     }
 
-    /// Marks the chains with an argument slot in `audio` (one flag per slot of the
-    /// engine's arguments) as varying. Done once, when the model is compiled.
-    pub fn mark_varying(&mut self, audio: &[bool]) {
+    /// Marks as varying the chains with an audio-rate argument (`audio`: one flag per slot of
+    /// the engine's arguments) or a column that mixes scaling classes (`class`: one per slot),
+    /// whose equal arguments before the factors need not stay equal. Done once, when the
+    /// model is compiled.
+    pub fn mark_varying(&mut self, audio: &[bool], class: &[u8]) {
         for (c, &(start, len, _)) in self.chains.iter().enumerate() {
             let range = start as usize..(start + len) as usize;
-            self.varying[c] = self
-                .cols
-                .iter()
-                .any(|&col| audio[col + range.start..col + range.end].contains(&true));
+            self.varying[c] = self.cols.iter().any(|&col| {
+                let slots = col + range.start..col + range.end;
+                let classes = &class[slots.clone()];
+                audio[slots].contains(&true) || classes.iter().any(|&k| k != classes[0])
+            });
         }
     }
 
-    /// Recomputes which chains are uniform, after the control arguments changed. Never
-    /// allocates.
-    pub fn find_uniform(&mut self, args: &[f64]) {
+    /// Recomputes which chains are uniform from the arguments before their class factors
+    /// (`raw`: a column has one class, so equal there means equal at any factor), after a
+    /// parameter changed. Never allocates.
+    pub fn find_uniform(&mut self, raw: &[f64]) {
         for (c, &(start, len, _)) in self.chains.iter().enumerate() {
             let range = start as usize..(start + len) as usize;
             self.uniform[c] = !self.varying[c]
                 && self.cols.iter().all(|&col| {
-                    let v = &args[col + range.start..col + range.end];
+                    let v = &raw[col + range.start..col + range.end];
                     let first = v[0].to_bits();
                     v.iter().all(|a| a.to_bits() == first)
                 });

@@ -173,9 +173,13 @@ mod tests {
         input[0] = -0.01;
         let (mut a, mut b) = (vec![0.0; frames], vec![0.0; frames]);
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        for (block, value) in [0.1, 0.15, 0.1].into_iter().enumerate() {
+        let gains = [1.0, 1.0, 1.0, 0.7, 1.3];
+        for (block, value) in [0.1, 0.15, 0.1, 0.1, 0.15].into_iter().enumerate() {
             chained.set_param(k2, value).unwrap();
             reference.set_param(k2, value).unwrap();
+            // A class gain alone keeps the chain uniform.
+            chained.set_class_gain(crate::ScaleClass::Stiffness, gains[block]);
+            reference.set_class_gain(crate::ScaleClass::Stiffness, gains[block]);
             chained.apply_pending_changes();
             let linear = &chained.interactions.linear;
             assert_eq!(linear.chains.len(), 1, "{:?}", linear.chains);
