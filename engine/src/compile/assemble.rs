@@ -78,6 +78,7 @@ impl<'a> Cx<'a> {
         let mut longest_chain = 0;
         for g in interactions.groups_mut() {
             g.find_chains();
+            g.find_rows(bound.singles.len());
             g.mark_varying(&audio_slots, &slot_class);
             longest_chain = longest_chain.max(g.longest_chain());
         }

@@ -17,11 +17,18 @@ pub(crate) struct Group {
     /// (d = its width). See [`Group::apply`].
     pub chains: Vec<(u32, u32, u32)>,
     /// Per chain: every link's arguments are equal (column by column, bit for bit, before
-    /// the class factors), so the
-    /// law reads the first link's and the loop streams no argument ([`Group::find_uniform`]).
+    /// the class factors), so the law reads the first link's and the loop streams no
+    /// argument ([`Group::find_uniform`]).
     pub uniform: Vec<bool>,
-    /// Per chain: an argument is audio-rate (it may change within a block): never uniform.
+    /// Per chain: an argument is audio-rate (it may change within a block) or a column
+    /// mixes scaling classes: never uniform.
     pub varying: Vec<bool>,
+    /// Per chain: the number of chains, this one first, that are the rows of one mesh (see
+    /// [`Group::find_rows`]); 0 when it starts none.
+    pub rows: Vec<u32>,
+    /// Per chain starting rows: every row is uniform with the same arguments, so the rows
+    /// run as one loop ([`Group::find_uniform`]).
+    pub rows_uniform: Vec<bool>,
 }
 
 /// The shortest run of links [`Group::apply`] runs as a chain.
@@ -60,6 +67,46 @@ impl Group {
         }
         self.uniform = vec![false; self.chains.len()];
         self.varying = vec![false; self.chains.len()];
+        self.rows = vec![0; self.chains.len()];
+        self.rows_uniform = vec![false; self.chains.len()];
+    }
+
+    /// Finds the rows of meshes written element by element (done once, when the model is
+    /// compiled): at least two chains of m links with d = 1, one after the other in the list,
+    /// each starting m + 1 points after the previous one, over single masses only (points
+    /// below `singles`, whose F the mass pass resets to +0).
+    ///
+    /// Such rows run as one chain over all their points (see [`Group::apply`]) in which the
+    /// links that are not there (from a row's last point to the next row's first) have force
+    /// exactly +0. That changes no bit: at a row's end (F + s) − (+0) is F + s, and at the next
+    /// row's start (F + (+0)) − s is F − s because F is never −0 there (it starts at +0, and
+    /// in round-to-nearest a sum or difference is −0 only when its first operand is −0).
+    pub fn find_rows(&mut self, singles: usize) {
+        let n = self.chains.len();
+        let mut c = 0;
+        while c < n {
+            let (start, m, d) = self.chains[c];
+            let q = self.a[start as usize];
+            let mut end = c + 1;
+            while end < n && d == 1 {
+                let (s2, m2, d2) = self.chains[end];
+                let k = (end - c) as u32;
+                if d2 != 1
+                    || m2 != m
+                    || s2 != start + k * m
+                    || self.a[s2 as usize] != q + k * (m + 1)
+                {
+                    break;
+                }
+                end += 1;
+            }
+            let rows = end - c;
+            let last_point = q as usize + rows * (m as usize + 1) - 1;
+            if rows >= 2 && last_point < singles {
+                self.rows[c] = rows as u32;
+            }
+            c = end;
+        }
     }
 
     /// Marks as varying the chains with an audio-rate argument (`audio`: one flag per slot of
@@ -90,11 +137,34 @@ impl Group {
                     v.iter().all(|a| a.to_bits() == first)
                 });
         }
+        for c in 0..self.chains.len() {
+            let rows = self.rows[c] as usize;
+            let first = self.chains[c].0 as usize;
+            self.rows_uniform[c] = rows > 0
+                && (c..c + rows).all(|r| {
+                    let start = self.chains[r].0 as usize;
+                    self.uniform[r]
+                        && self
+                            .cols
+                            .iter()
+                            .all(|&col| raw[col + start].to_bits() == raw[col + first].to_bits())
+                });
+        }
     }
 
-    /// The longest chain's length.
+    /// The longest chain's length, rows of a mesh counting as one chain over all their points.
     pub fn longest_chain(&self) -> usize {
-        self.chains.iter().map(|c| c.1 as usize).max().unwrap_or(0)
+        let rows = self
+            .chains
+            .iter()
+            .zip(&self.rows)
+            .map(|(c, &r)| r as usize * (c.1 as usize + 1));
+        self.chains
+            .iter()
+            .map(|c| c.1 as usize)
+            .chain(rows)
+            .max()
+            .unwrap_or(0)
     }
 
     #[inline(always)]
@@ -119,11 +189,39 @@ impl Group {
         // lengths stay in registers.
         let (x, xp, f, scratch) = (&p.x[..], &p.xp[..], &mut p.f[..], &mut p.s[..]);
         let mut i = 0;
-        for (c, &(start, len, d)) in self.chains.iter().enumerate() {
+        let mut c = 0;
+        while c < self.chains.len() {
+            let (start, len, d) = self.chains[c];
             let (start, m, d) = (start as usize, len as usize, d as usize);
             let uniform = self.uniform.get(c).copied().unwrap_or(false);
             scatter(i, &a[i..start], &b[i..start], x, xp, f, &law);
             let q = a[start] as usize;
+            if self.rows_uniform.get(c).copied().unwrap_or(false) {
+                // Rows of a mesh as one chain over all their points (see `find_rows`).
+                let rows = self.rows[c] as usize;
+                let w = m + 1;
+                let total = rows * w - 1;
+                let (xs, xps) = (&x[q..q + total + 1], &xp[q..q + total + 1]);
+                let s = &mut scratch[..total];
+                for j in 0..total {
+                    let dx = xs[j] - xs[j + 1];
+                    let dv = (xs[j] - xps[j]) - (xs[j + 1] - xps[j + 1]);
+                    s[j] = law(start, dx, dv);
+                }
+                for r in 1..rows {
+                    s[r * w - 1] = 0.0;
+                }
+                let fs = &mut f[q..q + total + 1];
+                fs[0] -= s[0];
+                let (both, s_before, s_now) = (&mut fs[1..total], &s[..total - 1], &s[1..total]);
+                for t in 0..total - 1 {
+                    both[t] = (both[t] + s_before[t]) - s_now[t];
+                }
+                fs[total] += s[total - 1];
+                i = start + rows * m;
+                c += rows;
+                continue;
+            }
             let (xa, xb) = (&x[q..q + m], &x[q + d..q + d + m]);
             let (xpa, xpb) = (&xp[q..q + m], &xp[q + d..q + d + m]);
             let s = &mut scratch[..m];
@@ -156,6 +254,7 @@ impl Group {
                 fs[t] += s[t - d];
             }
             i = start + m;
+            c += 1;
         }
         scatter(i, &a[i..], &b[i..], x, xp, f, &law);
     }

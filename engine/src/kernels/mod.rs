@@ -24,27 +24,32 @@ mod tests {
         // A link out of the chain between two runs, and a nonlinear law on the same points.
         text += "@x springDamper @m3 @m30 0.05 0.\n@c contact @m10 @m20 0.05 0.001 0.\n";
         text += "@l40 springDamper @m39 @g1 0.1 0.001\n@in1 frcInput @m7\n@out1 posOutput @m25\n";
-        chain_and_scatter_agree(&text, 1);
+        assert!(!chain_and_scatter_agree(&text, 1));
         // A 7 × 6 mesh written element by element: rows (d = 1), then the links between rows
-        // (d = 6), with a corner pinned to a ground.
-        let (len, w) = (7, 6);
-        let mut text = String::from("@g ground 0.\n");
-        for i in 0..len * w {
-            text += &format!("@n{i} mass 1. 0. 0.\n");
-        }
-        let mut k = 0;
-        for r in 0..len {
-            for c in 0..w - 1 {
-                let i = r * w + c;
-                text += &format!("@h{k} springDamper @n{i} @n{} 0.1 0.001\n", i + 1);
-                k += 1;
+        // (d = 6), with a corner pinned to a ground. Its rows run as one chain over all their
+        // points, unless one row link reads other arguments.
+        for odd in [None, Some(12)] {
+            let (len, w) = (7, 6);
+            let mut text = String::from("@g ground 0.\n");
+            for i in 0..len * w {
+                text += &format!("@n{i} mass 1. 0. 0.\n");
             }
+            let mut k = 0;
+            for r in 0..len {
+                for c in 0..w - 1 {
+                    let i = r * w + c;
+                    let stiffness = if odd == Some(k) { 0.12 } else { 0.1 };
+                    text += &format!("@h{k} springDamper @n{i} @n{} {stiffness} 0.001\n", i + 1);
+                    k += 1;
+                }
+            }
+            for i in 0..(len - 1) * w {
+                text += &format!("@v{i} springDamper @n{i} @n{} 0.1 0.001\n", i + w);
+            }
+            text += "@p springDamper @g @n0 0.1 0.001\n@in1 frcInput @n8\n@out1 posOutput @n30\n";
+            let merged = chain_and_scatter_agree(&text, w as u32);
+            assert_eq!(merged, odd.is_none());
         }
-        for i in 0..(len - 1) * w {
-            text += &format!("@v{i} springDamper @n{i} @n{} 0.1 0.001\n", i + w);
-        }
-        text += "@p springDamper @g @n0 0.1 0.001\n@in1 frcInput @n8\n@out1 posOutput @n30\n";
-        chain_and_scatter_agree(&text, w as u32);
     }
 
     /// Plain masses (a = 2, b = −1, g = +0) run their own loop; the general update is its
@@ -52,11 +57,7 @@ mod tests {
     /// and back, and with gravity and −0 gravity beside them.
     #[test]
     fn plain_masses_equal_the_general_update() {
-        let mut text = String::from(
-            "@K param 0.
-@g0 ground 0.
-",
-        );
+        let mut text = String::from("@K param 0.\n@g0 ground 0.\n");
         for i in 0..30 {
             text += &match i {
                 7 => "@m7 osc 1. K 0. 0. 0.
@@ -194,13 +195,16 @@ mod tests {
         assert_eq!(bits(chained.positions()), bits(reference.positions()));
     }
 
-    fn chain_and_scatter_agree(text: &str, widest: u32) {
+    /// Runs `text` with its chains and with the scatter only; returns whether rows of a mesh
+    /// ran as one chain.
+    fn chain_and_scatter_agree(text: &str, widest: u32) -> bool {
         let spec = parse(text).spec.expect("parses");
         let mut chained = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
         let bands = &chained.interactions.linear.chains;
         assert!(bands.iter().any(|b| b.2 == widest), "{bands:?}");
         let mut reference = chained.clone();
         reference.interactions.linear.chains.clear();
+        let merged = chained.interactions.linear.rows_uniform.contains(&true);
         let frames = 4096;
         let mut input = vec![0.0; frames];
         input[0] = -0.01;
@@ -211,6 +215,7 @@ mod tests {
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&a), bits(&b));
         assert_eq!(bits(chained.positions()), bits(reference.positions()));
+        merged
     }
 
     /// The sample loop gives the same bits whichever instruction set runs it (the baseline or
