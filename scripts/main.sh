@@ -16,6 +16,12 @@ mkdir -p out
 "$ressort" render models/mesh-25x20.mdl -o out/mesh-25x20.wav --seconds 3 --impulse in1=-0.01
 "$ressort" render models/string-1000.mdl -o out/string-1000.wav --seconds 3 --impulse in1=-0.01
 "$ressort" bench models/string-1000.mdl
+# Compiled Faust mi.lib on the same element-by-element models, where the shared benchmark is
+# present: builds Faust's renderer into target/faust-mi (faust and g++ from Debian) and prints
+# the comparison; the engine benchmark below then sets its twins against that renderer.
+if [ -f ../shared/bench/faust-mi/compare.sh ]; then
+  bash ../shared/bench/faust-mi/compare.sh "$ressort"
+fi
 cargo bench -p ressort-engine --bench reference_models --locked -- "$@"
 cargo bench -p ressort-engine --bench load_time --locked -- "$@"
 # The plugin: CLAP and VST3 bundles in target/bundled/, and the standalone application.

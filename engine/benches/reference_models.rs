@@ -10,8 +10,16 @@
 //! Each model is compiled 9 times (the median is reported); then it renders 64-sample blocks at
 //! 48 kHz with an impulse on in1 and slow signals on its other inputs, in 7 timed runs of about
 //! 0.25 s of wall time each after a warm-up; the median run gives ns per sample.
+//!
+//! Then the element-by-element twins of compiled Faust `mi.lib` (the scripts of
+//! `../shared/bench/faust-mi/scripts`, or `$FAUST_MI_SCRIPTS`) are measured the same way and,
+//! when Faust's renderer has been built (`bash ../shared/bench/faust-mi/compare.sh` builds
+//! `target/faust-mi/build/render-native`; or `$FAUST_MI_RENDER`), set against Faust's best of
+//! five runs, measured in the same process run.
 
-use ressort_engine::{compile, reference, CompileOptions, Engine, InputUse, ModelSpec};
+use ressort_engine::{compile, parse, reference, CompileOptions, Engine, InputUse, ModelSpec};
+use std::path::{Path, PathBuf};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 const SAMPLE_RATE_HZ: f64 = 48_000.0;
@@ -21,7 +29,7 @@ const TIMED_RUNS: usize = 7;
 const RUN_WALL_TIME: Duration = Duration::from_millis(250);
 
 struct Row {
-    name: &'static str,
+    name: String,
     points: usize,
     interactions: usize,
     compile_ms: f64,
@@ -57,7 +65,7 @@ fn inputs(e: &Engine, block: usize, first: bool) -> Vec<f64> {
     v
 }
 
-fn measure(name: &'static str, spec: &ModelSpec) -> Row {
+fn measure(name: &str, spec: &ModelSpec) -> Row {
     let options = CompileOptions::at(SAMPLE_RATE_HZ);
     let compile_ms = median(
         (0..COMPILE_RUNS)
@@ -99,7 +107,7 @@ fn measure(name: &'static str, spec: &ModelSpec) -> Row {
         e.guard_event()
     );
     Row {
-        name,
+        name: name.to_string(),
         points: e.info().num_points,
         interactions: e.info().num_interactions,
         compile_ms,
@@ -117,6 +125,60 @@ fn cpu_model() -> String {
                 .map(|m| m.trim().to_string())
         })
         .unwrap_or_else(|| "unknown CPU".to_string())
+}
+
+/// The faust-mi twin scripts, by name (`osc`, `string1000`, …), sorted.
+fn twin_scripts() -> Vec<(String, PathBuf)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let dir = std::env::var_os("FAUST_MI_SCRIPTS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("../shared/bench/faust-mi/scripts"));
+    let mut found: Vec<(String, PathBuf)> = std::fs::read_dir(&dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "mdl"))
+                .filter_map(|p| Some((p.file_stem()?.to_str()?.to_string(), p)))
+                .collect()
+        })
+        .unwrap_or_default();
+    found.sort();
+    found
+}
+
+/// Faust's renderer, if built.
+fn faust_renderer() -> Option<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let path = std::env::var_os("FAUST_MI_RENDER")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("target/faust-mi/build/render-native"));
+    path.is_file().then_some(path)
+}
+
+/// Faust's best ns/sample on `model` (or its `_cg` build, as compare.sh picks it): one
+/// warm-up, then the best of five runs of 200,000 samples.
+fn faust_ns(render: &Path, model: &str) -> Option<f64> {
+    let list = Command::new(render).arg("--list").output().ok()?;
+    let list = String::from_utf8_lossy(&list.stdout);
+    let has = |m: &str| list.lines().any(|l| l.split_whitespace().next() == Some(m));
+    let name = if has(model) {
+        model.to_string()
+    } else if has(&format!("{model}_cg")) {
+        format!("{model}_cg")
+    } else {
+        return None;
+    };
+    let out = std::env::temp_dir().join(format!("ressort-faust-{}.f64", std::process::id()));
+    let run = Command::new(render)
+        .args([name.as_str(), "200000"])
+        .arg(&out)
+        .args(["--runs", "5"])
+        .output()
+        .ok()?;
+    let _ = std::fs::remove_file(&out);
+    let text = String::from_utf8_lossy(&run.stdout);
+    text.split_whitespace()
+        .find_map(|w| w.strip_prefix("ns_per_sample_best="))
+        .and_then(|v| v.parse().ok())
 }
 
 fn main() {
@@ -138,6 +200,30 @@ fn main() {
             row.compile_ms
         );
         rows.push(row);
+    }
+
+    // The element-by-element twins of compiled Faust.
+    let render = faust_renderer();
+    let mut twins = Vec::new();
+    for (name, path) in twin_scripts() {
+        let row_name = format!("faust_mi_{name}");
+        if !filters.is_empty() && !filters.iter().any(|f| row_name.contains(f.as_str())) {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).expect("read a faust-mi script");
+        let spec = parse(&text).spec.expect("the faust-mi scripts parse");
+        let row = measure(&row_name, &spec);
+        let faust = render.as_deref().and_then(|r| faust_ns(r, &name));
+        eprintln!(
+            "{:<22} {:>8.1} ns/sample  Faust {}",
+            row.name,
+            row.ns_per_sample,
+            faust.map_or("not built".to_string(), |f| format!(
+                "{f:.1} ns/sample, {:.2}×",
+                f / row.ns_per_sample
+            ))
+        );
+        twins.push((name, row, faust));
     }
 
     let mut table = String::new();
@@ -183,8 +269,34 @@ fn main() {
             m.percent_of_core()
         ));
     }
+    let mut twin_table = String::new();
+    if !twins.is_empty() {
+        twin_table.push_str(
+            "## Element by element, against compiled Faust mi.lib\n\n\
+             The faust-mi scripts (`../shared/bench/faust-mi/scripts`: what MIMS4Max and \
+             `~generate` write, one `mass` and one `springDamper` per line) on the engine as \
+             above, and Faust's renderer (`-O3 -march=native`, double; built by `bash \
+             ../shared/bench/faust-mi/compare.sh`) on the same models, best of five runs of \
+             200,000 samples, in the same run. Ratio = Faust ns / Ressort ns.\n\n\
+             | model | points | interactions | Faust ns/sample | Ressort ns/sample | ratio |\n\
+             |---|---:|---:|---:|---:|---:|\n",
+        );
+        for (name, r, faust) in &twins {
+            let (f, ratio) = match faust {
+                Some(f) => (format!("{f:.1}"), format!("{:.2}×", f / r.ns_per_sample)),
+                None => ("not built".to_string(), "–".to_string()),
+            };
+            twin_table.push_str(&format!(
+                "| {name} | {} | {} | {f} | {:.1} | {ratio} |\n",
+                r.points, r.interactions, r.ns_per_sample
+            ));
+        }
+    }
     println!("{table}");
     print!("{ratios}");
+    if !twin_table.is_empty() {
+        println!("\n{twin_table}");
+    }
 
     if save {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/RESULTS.md");
@@ -194,7 +306,7 @@ fn main() {
              (also `bash scripts/main.sh --save`).\n\n\
              Machine: {} ({} logical cores). Sample rate {} Hz, blocks of {} frames, median of \
              {} runs; compile time is the median of {} compiles of the builder spec.\n\n\
-             {table}\n{ratios}",
+             {table}\n{ratios}\n{twin_table}",
             cpu_model(),
             std::thread::available_parallelism()
                 .map(|n| n.get())
