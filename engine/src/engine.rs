@@ -37,6 +37,14 @@ pub(crate) struct Points {
     pub s: Vec<f64>,
 }
 
+/// The host buffers' shape for one block of [`Engine::process`].
+struct BlockIo<'a> {
+    frames: usize,
+    inputs: &'a [f64],
+    in_channels: usize,
+    out_channels: usize,
+}
+
 /// The argument slots of one macro in `Engine::args`: M, K, K2 (stiff strings), Z, Zo.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct MacroSlots {
@@ -867,6 +875,10 @@ impl Engine {
 
     /// The sample loop of [`Engine::process`], inlined into each instruction set's copy.
     /// Returns how many samples ran (fewer when the guard trips).
+    ///
+    /// Stage 7 (the motion buffers) runs only on the samples where the motion counter is 0:
+    /// the samples between them run a loop without it, and so does every sample while no
+    /// store is attached.
     #[inline(always)]
     fn run(
         &mut self,
@@ -876,40 +888,90 @@ impl Engine {
         outputs: &mut [f64],
         out_channels: usize,
     ) -> usize {
+        let io = BlockIo {
+            frames,
+            inputs,
+            in_channels,
+            out_channels,
+        };
         let scale = self.class_factors();
-        let mut simulated = 0;
-        for n in 0..frames {
-            let input = |ch: u32| -> f64 {
-                let ch = ch as usize;
-                if ch < in_channels {
-                    let v = inputs[ch * frames + n];
-                    if v.is_finite() {
-                        v
-                    } else {
-                        0.0
-                    }
+        let mut n = 0;
+        while n < frames {
+            let watched = self.motion.is_some();
+            let until_write = match (watched, self.motion_counter) {
+                (false, _) => frames,
+                (true, 0) => 0,
+                (true, c) => (self.motion_interval - c) as usize,
+            };
+            let end = frames.min(n + until_write);
+            for k in n..end {
+                if self.sample::<false>(k, &io, outputs, &scale) {
+                    return k + 1;
+                }
+            }
+            if watched {
+                self.motion_counter = ((self.motion_counter as usize + (end - n))
+                    % self.motion_interval as usize) as u32;
+            }
+            n = end;
+            if n < frames && watched {
+                // The counter is 0: this sample writes the motion buffers.
+                if self.sample::<true>(n, &io, outputs, &scale) {
+                    return n + 1;
+                }
+                self.motion_counter = 1 % self.motion_interval;
+                n += 1;
+            }
+        }
+        frames
+    }
+
+    /// Sample `n` of a block: stages 1 to 7, the guard's check and the periodic flush.
+    /// Returns true when the guard tripped (the rest of the block's outputs are then 0).
+    #[inline(always)]
+    fn sample<const MOTION: bool>(
+        &mut self,
+        n: usize,
+        io: &BlockIo<'_>,
+        outputs: &mut [f64],
+        scale: &[f64; NUM_ARG_CLASSES],
+    ) -> bool {
+        let input = |ch: u32| -> f64 {
+            let ch = ch as usize;
+            if ch < io.in_channels {
+                let v = io.inputs[ch * io.frames + n];
+                if v.is_finite() {
+                    v
                 } else {
                     0.0
                 }
-            };
-            self.step(&input, &scale);
-            simulated += 1;
-            if let Some(bad) = self.write_outputs(n, frames, out_channels, outputs) {
-                self.trip(bad.0, None, Some(bad.1));
-                for ch in 0..out_channels {
-                    outputs[ch * frames + n..(ch + 1) * frames].fill(0.0);
-                }
-                break;
+            } else {
+                0.0
             }
-            self.samples_since_reset += 1;
-            if self.samples_since_reset.is_multiple_of(FLUSH_INTERVAL) {
-                self.flush_tiny();
+        };
+        self.step(&input, scale);
+        // Stage 7: motion buffers, on the first sample and then every R samples.
+        if MOTION {
+            if let Some(store) = &self.motion {
+                store.write(&self.points.x[..self.info.num_points]);
             }
         }
-        simulated
+        if let Some(bad) = self.write_outputs(n, io.frames, io.out_channels, outputs) {
+            self.trip(bad.0, None, Some(bad.1));
+            for ch in 0..io.out_channels {
+                outputs[ch * io.frames + n..(ch + 1) * io.frames].fill(0.0);
+            }
+            return true;
+        }
+        self.samples_since_reset += 1;
+        if self.samples_since_reset.is_multiple_of(FLUSH_INTERVAL) {
+            self.flush_tiny();
+        }
+        false
     }
 
-    /// One sample: stages 1 to 5 and 7 of spec §1.5 (stage 6 is `write_outputs`).
+    /// One sample: stages 1 to 5 of spec §1.5 (stage 6 is `write_outputs`, stage 7 in
+    /// `sample`).
     #[inline(always)]
     fn step(&mut self, input: &impl Fn(u32) -> f64, scale: &[f64; NUM_ARG_CLASSES]) {
         // Stage 1 a: avatars.
@@ -946,16 +1008,6 @@ impl Engine {
         }
         // Stage 5: connection-point force spreading.
         self.proxies.spread_forces(&mut self.points);
-        // Stage 7: motion buffers, on the first sample and then every R samples.
-        if let Some(store) = &self.motion {
-            if self.motion_counter == 0 {
-                store.write(&self.points.x[..self.info.num_points]);
-            }
-            self.motion_counter += 1;
-            if self.motion_counter >= self.motion_interval {
-                self.motion_counter = 0;
-            }
-        }
     }
 
     /// Stage 6: writes frame `n` of every output. Returns the first bad value's kind and

@@ -421,6 +421,57 @@ fn motion_buffers_are_written_on_the_first_sample_and_every_interval() {
     assert_eq!(store.frames_written(), 3);
 }
 
+/// Stage 7 runs on its own samples whatever the block sizes: with R = 7, after every block of
+/// a ragged sequence the store holds the positions of the last sample n with n % 7 = 0, and
+/// as many frames as such samples.
+#[test]
+fn motion_frames_land_on_their_samples_in_any_block_sizes() {
+    let spec = reference::string_1000();
+    let options = CompileOptions {
+        sample_rate_hz: 44_100.0,
+        motion_interval: 7,
+    };
+    let mut plain = compile(&spec, &options).unwrap();
+    let mut watched = plain.clone();
+    let store = Arc::new(MotionStore::new(watched.info().num_points));
+    watched.set_motion_store(Some(Arc::clone(&store)));
+    let n_in = plain.info().num_inputs();
+    let n_out = plain.info().num_outputs();
+    let points = plain.info().num_points;
+    // The positions after every sample, one sample at a time.
+    let total = 200;
+    let mut history = Vec::new();
+    let mut out = vec![0.0; n_out];
+    for n in 0..total {
+        let mut input = vec![0.0; n_in];
+        if n == 0 && n_in > 0 {
+            input[0] = -0.01;
+        }
+        plain.process(1, &input, &mut out);
+        history.push(plain.positions()[..points].to_vec());
+    }
+    let mut done = 0;
+    let mut frame = vec![0.0; store.len()];
+    for len in [1, 3, 11, 7, 6, 1, 20, 64, 13, 74] {
+        let mut input = vec![0.0; n_in * len];
+        if done == 0 && n_in > 0 {
+            input[0] = -0.01;
+        }
+        let mut out = vec![0.0; n_out * len];
+        watched.process(len, &input, &mut out);
+        done += len;
+        let last_write = (done - 1) / 7 * 7;
+        assert_eq!(
+            store.frames_written() as usize,
+            last_write / 7 + 1,
+            "after {done}"
+        );
+        store.read(&mut frame).unwrap();
+        assert_eq!(frame, history[last_write], "after {done} samples");
+    }
+    assert_eq!(done, total);
+}
+
 #[test]
 fn stability_report_names_masses_and_structures() {
     // A string with K/M = 0.1 passes everything.
