@@ -151,6 +151,9 @@ pub struct Instrument {
     fade_len: usize,
     /// A model whose fade ended, waiting for [`Instrument::take_retired`].
     retired: Option<Box<Prepared>>,
+    /// The current model's outputs were exactly 0 in the last span, with no voice sounding:
+    /// a new model replaces it without a crossfade.
+    current_silent: bool,
     controls: Controls,
     smoothed: Smoothed,
     gains: Gains,
@@ -201,6 +204,7 @@ impl Instrument {
             fade_left: 0,
             fade_len: 1,
             retired: None,
+            current_silent: false,
             controls,
             last_output_gain: smoothed.output_gain.value,
             smoothed,
@@ -261,9 +265,23 @@ impl Instrument {
     }
 
     /// Plays `model` from now on, crossfading from the running one over [`SWAP_FADE_MS`]
-    /// (at once when nothing ran). Returns a model to free off the audio thread: the one
-    /// that was still fading out. Realtime-safe.
+    /// (at once when nothing ran, or when the running one is silent: its outputs exactly 0
+    /// in the last span and no voice sounding, so that a fade would only run two models for
+    /// nothing). Returns a model to free off the audio thread: the one that was still fading
+    /// out, or the silent one replaced. Realtime-safe.
     pub fn set_model(&mut self, model: Box<Prepared>) -> Option<Box<Prepared>> {
+        if self.current_silent {
+            // The new model fades in from the silence over the same 20 ms, alone; a fade
+            // still running (towards the silent model) goes on towards the new one.
+            self.current_silent = false;
+            let old = self.current.replace(model);
+            if self.outgoing.is_none() {
+                self.fade_len = ((SWAP_FADE_MS * 1e-3 * self.sample_rate) as usize).max(1);
+                self.fade_left = self.fade_len;
+            }
+            self.apply();
+            return old;
+        }
         let stale = self.outgoing.take();
         self.outgoing = self.current.replace(model);
         self.fade_len = ((SWAP_FADE_MS * 1e-3 * self.sample_rate) as usize).max(1);
@@ -766,6 +784,11 @@ impl Instrument {
                 }
             }
         }
+        self.current_silent = self.current.as_deref().is_some_and(|m| {
+            let n_out = m.outputs.len() / CHUNK;
+            m.outputs[..n_out * len].iter().all(|&v| v == 0.0)
+                && m.bank.as_ref().is_none_or(|b| b.sounding() == 0)
+        });
         if let Some(old) = self.outgoing.as_deref_mut() {
             let n_in = old.roles.len();
             let n_out = old.outputs.len() / CHUNK;

@@ -63,9 +63,9 @@ impl OutputStage {
         self.guard_step = 1.0 / (GUARD_FADE_MS * 1e-3 * sample_rate).max(1.0);
     }
 
-    /// Writes one span to `out[c][offset..offset + span.len]` for every host channel. The
-    /// outgoing model, if any, is faded out over `fade_left` of `fade_len` samples
-    /// (`fade_left` counts down). Returns (tripped, loudest |sample| written): tripped when
+    /// Writes one span to `out[c][offset..offset + span.len]` for every host channel. While
+    /// `fade_left` of `fade_len` samples count down, the current model fades in and the
+    /// outgoing one, if any, fades out. Returns (tripped, loudest |sample| written): tripped when
     /// the model's guard tripped ([`Span::tripped`]) or an output was not finite.
     pub fn render(
         &mut self,
@@ -83,7 +83,8 @@ impl OutputStage {
         let mut loudest: f64 = 0.0;
         let mut frame = [0.0f64; MAX_HOST_OUTPUTS];
         for i in 0..len {
-            let t = if *fade_left > 0 && outgoing.is_some() {
+            // Without an outgoing model (it was silent) the new one fades in from 0.
+            let t = if *fade_left > 0 {
                 *fade_left as f64 / fade_len as f64
             } else {
                 0.0
@@ -94,9 +95,8 @@ impl OutputStage {
             for (c, y) in frame[..channels].iter_mut().enumerate() {
                 let mut x = current.map_or(0.0, |m| model_channel(m, c, i, len));
                 if t > 0.0 {
-                    if let Some(old) = outgoing {
-                        x = x * (1.0 - t) + model_channel(old, c, i, len) * t;
-                    }
+                    let old = outgoing.map_or(0.0, |old| model_channel(old, c, i, len));
+                    x = x * (1.0 - t) + old * t;
                 }
                 x *= g;
                 if span.dc_on {
