@@ -144,8 +144,10 @@ struct BenchArgs {
     voices: Option<usize>,
     /// Measure what automation costs: the same model steady and with its Stiffness gain swept
     /// (×0.5 to ×1, one cycle per second, a new value every 16 samples as the plugin's
-    /// smoother gives), in one run, and print both and their ratio.
-    #[arg(long, conflicts_with = "voices")]
+    /// smoother gives), in one run, and print both and their ratio. With `--voices`, the
+    /// bank plays with the instrument's Stiffness swept the same way (compare with a run
+    /// without `--sweep`).
+    #[arg(long)]
     sweep: bool,
 }
 
@@ -529,7 +531,7 @@ fn bench(a: &BenchArgs) -> Result<(), Failure> {
         )));
     }
     if let Some(voices) = a.voices {
-        return play::bench_voices(&a.model, a.sample_rate, a.seconds, voices);
+        return play::bench_voices(&a.model, a.sample_rate, a.seconds, voices, a.sweep);
     }
     let bytes = std::fs::read(&a.model)
         .map_err(|e| usage(format!("cannot read {}: {e}", a.model.display())))?;

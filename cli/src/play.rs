@@ -386,6 +386,7 @@ pub fn bench_voices(
     sample_rate: f64,
     seconds: f64,
     voices: usize,
+    sweep: bool,
 ) -> Result<(), Failure> {
     if !(1..=MAX_VOICES).contains(&voices) {
         return Err(usage(format!(
@@ -414,7 +415,7 @@ pub fn bench_voices(
         prepared.engine.info().num_interactions,
     );
     let key = prepared.settings.reference_key.round().clamp(0.0, 127.0) as u8;
-    let controls = Controls::DEFAULT;
+    let mut controls = Controls::DEFAULT;
     let mut inst = Instrument::new(sample_rate, controls);
     inst.set_model(Box::new(prepared));
     let notes: Vec<Timed> = (0..voices)
@@ -434,6 +435,11 @@ pub fn bench_voices(
         let first = done == 0;
         let mut events = notes.iter().copied().filter(|_| first);
         let mut out: [&mut [f32]; 2] = [&mut l, &mut r];
+        if sweep {
+            // Stiffness automated: ×0.5 … ×1, one cycle per second (every voice retunes).
+            let phase = std::f64::consts::TAU * done as f64 / sample_rate;
+            controls.stiffness_octaves = -0.5 + 0.5 * phase.cos();
+        }
         inst.process(block, &no_input, false, &mut events, &controls, &mut out);
         most = most.max(inst.voice_count().0);
         done += block as u64;
@@ -449,7 +455,8 @@ pub fn bench_voices(
     );
     println!(
         "ns_per_sample={ns_per_sample:.3} realtime_factor={realtime_factor:.3} points={points} \
-         interactions={interactions} compile_ms={compile_ms:.3} voices={voices}"
+         interactions={interactions} compile_ms={compile_ms:.3} voices={voices}{}",
+        if sweep { " sweep=1" } else { "" }
     );
     Ok(())
 }

@@ -474,7 +474,17 @@ fn bench_sweep_prints_steady_and_swept_costs() {
     );
     let ratio = fields[1].1 / fields[0].1;
     assert!((fields[2].1 - ratio).abs() < 1e-2 * ratio, "{stdout}");
-    // `--sweep` measures one engine; a bank of voices is `--voices`.
-    let out = ressort(&["bench", model.to_str().unwrap(), "--sweep", "--voices", "2"]);
-    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    // With voices: the bank under a Stiffness sweep, marked on its last line.
+    let out = ressort(&[
+        "bench",
+        model.to_str().unwrap(),
+        "--seconds",
+        "0.05",
+        "--sweep",
+        "--voices",
+        "2",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let last = text(&out.stdout).lines().last().unwrap().to_string();
+    assert!(last.ends_with("voices=2 sweep=1"), "{last}");
 }

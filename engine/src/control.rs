@@ -157,6 +157,24 @@ impl ControlArgs {
         &self.raw
     }
 
+    /// The slots a change of class `c`'s factor rescales: those nothing derives from, and
+    /// those a single (its index) derives from. For the voice lanes, which keep one factor per
+    /// lane.
+    pub fn rescaled(
+        &self,
+        c: usize,
+    ) -> (&[u32], impl Iterator<Item = (usize, Option<usize>)> + '_) {
+        let derived = self.rescale_derived[c].iter().map(|&i| {
+            let slot = self.bindings[i as usize].slot as usize;
+            let single = match self.slot_dep[slot] {
+                NO_DEP | PROXY_DEP => None,
+                s => Some(s as usize),
+            };
+            (slot, single)
+        });
+        (&self.rescale[c], derived)
+    }
+
     /// The singles whose arguments the last refresh changed.
     pub fn dirty_singles(&self) -> &[u32] {
         &self.dirty[..self.num_dirty]

@@ -50,6 +50,8 @@ pub struct LaneEngine {
     chain: Vec<Lanes>,
     params_dirty: bool,
     gains_dirty: [bool; LANES],
+    /// The class factors each lane's arguments were last computed with.
+    seen: [[f64; NUM_ARG_CLASSES]; LANES],
     samples_since_reset: [u64; LANES],
     tripped: [bool; LANES],
     arch: pulp::Arch,
@@ -100,6 +102,7 @@ impl LaneEngine {
             chain: vec![zero; chain_len],
             params_dirty: true,
             gains_dirty: [true; LANES],
+            seen: [[0.0; NUM_ARG_CLASSES]; LANES],
             samples_since_reset: [0; LANES],
             tripped: [false; LANES],
             arch: pulp::Arch::new(),
@@ -201,10 +204,15 @@ impl LaneEngine {
         level
     }
 
-    /// Re-evaluates the arguments and coefficients after a parameter or gain change.
+    /// Re-evaluates the arguments and coefficients after a parameter or gain change. A
+    /// parameter change re-evaluates every binding and lane; a gain change (a note's tuning,
+    /// an MPE bend: every chunk while it moves) rescales only the arguments of the classes
+    /// whose factor moved in that lane and re-derives only the singles whose arguments
+    /// changed, as `ControlArgs` does for the plain engine (same operations, same bits).
     fn refresh(&mut self) {
         let t = &mut self.template;
-        if self.params_dirty {
+        let full = self.params_dirty;
+        if full {
             for bind in &t.control.bindings {
                 self.raw[bind.slot as usize] = t.program.eval(bind.expr, &t.params, &mut t.stack);
             }
@@ -220,20 +228,47 @@ impl LaneEngine {
             for (s, g) in scale.iter_mut().zip(self.gains[l]) {
                 *s *= g;
             }
-            for bind in &t.control.bindings {
-                let slot = bind.slot as usize;
-                self.args[slot][l] = self.raw[slot] * scale[bind.class as usize];
-            }
             let s = &t.singles;
-            for i in 0..s.len() {
-                let arg = |c: usize| self.args[s.cols[c] + i][l];
-                [
-                    self.a[i][l],
-                    self.b[i][l],
-                    self.inv_m[i][l],
-                    self.gravity[i][l],
-                ] = single_law(s.fixed[i], arg(0), arg(1), arg(2), arg(3));
+            let derive = |args: &[Lanes], out: &mut [&mut Vec<Lanes>; 4], i: usize| {
+                let arg = |c: usize| args[s.cols[c] + i][l];
+                let law = single_law(s.fixed[i], arg(0), arg(1), arg(2), arg(3));
+                for (o, v) in out.iter_mut().zip(law) {
+                    o[i][l] = v;
+                }
+            };
+            let mut out = [&mut self.a, &mut self.b, &mut self.inv_m, &mut self.gravity];
+            if full {
+                for bind in &t.control.bindings {
+                    let slot = bind.slot as usize;
+                    self.args[slot][l] = self.raw[slot] * scale[bind.class as usize];
+                }
+                for i in 0..s.len() {
+                    derive(&self.args, &mut out, i);
+                }
+            } else {
+                for (c, &f) in scale.iter().enumerate() {
+                    if f.to_bits() == self.seen[l][c].to_bits() {
+                        continue;
+                    }
+                    let (plain, derived) = t.control.rescaled(c);
+                    for &slot in plain {
+                        let slot = slot as usize;
+                        self.args[slot][l] = self.raw[slot] * f;
+                    }
+                    for (slot, single) in derived {
+                        let v = self.raw[slot] * f;
+                        if v.to_bits() != self.args[slot][l].to_bits() {
+                            self.args[slot][l] = v;
+                            if let Some(i) = single {
+                                // Derived right away: a single reads four slots, and
+                                // re-deriving one twice gives the same bits.
+                                derive(&self.args, &mut out, i);
+                            }
+                        }
+                    }
+                }
             }
+            self.seen[l] = scale;
             self.gains_dirty[l] = false;
         }
     }

@@ -72,6 +72,24 @@ fn lanes_equal_plain(
     let mut one_out = vec![0.0; n_out * frames];
     let mut loudest = 0.0f64;
     for block in 0..400 {
+        // Every 8 blocks one lane's tuning moves (a note's bend), alternately its stiffness
+        // and its damping gain, as a voice's class gains move in the bank.
+        if block % 8 == 4 {
+            let l = block / 8 % LANES;
+            let g = 1.0 + 0.002 * block as f64;
+            let class = if block % 16 == 4 {
+                ScaleClass::Stiffness
+            } else {
+                ScaleClass::Damping
+            };
+            let base = if class == ScaleClass::Stiffness {
+                k[l]
+            } else {
+                z[l]
+            };
+            lanes.set_class_gain(l, class, base * g);
+            plain[l].set_class_gain(class, base * g);
+        }
         lane_in.fill(0.0);
         for c in 0..n_in {
             for l in 0..LANES {
