@@ -147,7 +147,7 @@ pub struct TuneKey {
     voice: [f64; 4],
 }
 
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct Smoothed {
     stiffness: ChunkSmoother,
     damping: ChunkSmoother,
@@ -156,7 +156,64 @@ pub(super) struct Smoothed {
     pub position_gain: ChunkSmoother,
     pub output_gain: ChunkSmoother,
     macros: [ChunkSmoother; NUM_MACROS],
+    /// 2^Stiffness and 2^Damping (octaves) for the last exponent: while a control moves, every
+    /// voice asks for the same power every chunk.
+    pow2: [Pow2; 2],
+    /// Each macro slot's parameter value for the last position and binding asked: every
+    /// voice asks for the same one every chunk.
+    macro_values: [MacroValue; NUM_MACROS],
 }
+
+/// [`MacroBinding::value_at`] for the last slot position and binding asked (the same call,
+/// made once per distinct input).
+#[derive(Clone, Debug, Default)]
+struct MacroValue(std::cell::Cell<Option<[f64; 5]>>);
+
+impl MacroValue {
+    fn of(&self, b: &MacroBinding, position: f64) -> f64 {
+        let same = |x: f64, y: f64| x.to_bits() == y.to_bits();
+        match self.0.get() {
+            Some([p, lo, mid, hi, v])
+                if same(p, position)
+                    && same(lo, b.min)
+                    && same(mid, b.default)
+                    && same(hi, b.max) =>
+            {
+                v
+            }
+            _ => {
+                let v = b.value_at(position);
+                self.0.set(Some([position, b.min, b.default, b.max, v]));
+                v
+            }
+        }
+    }
+}
+
+/// 2^x for the last x asked: the same `powf` call, made once per distinct argument.
+#[derive(Clone, Debug, Default)]
+struct Pow2(std::cell::Cell<Option<(u64, f64)>>);
+
+impl Pow2 {
+    fn of(&self, x: f64) -> f64 {
+        match self.0.get() {
+            Some((k, v)) if k == x.to_bits() => v,
+            _ => {
+                let v = 2f64.powf(x);
+                self.0.set(Some((x.to_bits(), v)));
+                v
+            }
+        }
+    }
+}
+
+/// A voice's tuning gain (`tuning_gain`) for the last semitones, reference pitch and sample
+/// rate: its note rarely moves while the controls do.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TuningMemo(Option<(TuningInputs, f64)>);
+
+/// The bits of a tuning gain's inputs: semitones, reference pitch, sample rate.
+type TuningInputs = (u64, Option<u64>, u64);
 
 impl Smoothed {
     /// Every smoother on its target: a fresh start.
@@ -171,6 +228,8 @@ impl Smoothed {
             position_gain: gain(c.position_db),
             output_gain: gain(c.output_db),
             macros: c.macros.map(control),
+            pow2: Default::default(),
+            macro_values: Default::default(),
         }
     }
 
@@ -200,7 +259,14 @@ impl Smoothed {
     /// reference key, with the Damping gain asked for multiplied by `z_factor` (the Release
     /// damper of a released voice).
     pub fn gains(&self, view: &ClampView<'_>, note_st: f64, z_factor: f64) -> Gains {
-        self.gains_offset(view, note_st, z_factor, 0.0, 0.0)
+        self.gains_offset(
+            view,
+            note_st,
+            z_factor,
+            0.0,
+            0.0,
+            &mut TuningMemo::default(),
+        )
     }
 
     /// [`Smoothed::gains`] with a voice's own modulation of Stiffness and Damping, in octaves
@@ -212,16 +278,29 @@ impl Smoothed {
         z_factor: f64,
         k_octaves: f64,
         z_octaves: f64,
+        memo: &mut TuningMemo,
     ) -> Gains {
         let semitones = self.tune.value + note_st;
-        let tuning = tuning_gain(semitones, view.reference_pitch_hz, view.sample_rate);
-        let requested_k = 2f64.powf(self.stiffness.value + k_octaves) * tuning;
-        let requested_z = 2f64.powf(self.damping.value + z_octaves) * z_factor;
+        let key = (
+            semitones.to_bits(),
+            view.reference_pitch_hz.map(f64::to_bits),
+            view.sample_rate.to_bits(),
+        );
+        let tuning = match memo.0 {
+            Some((k, g)) if k == key => g,
+            _ => {
+                let g = tuning_gain(semitones, view.reference_pitch_hz, view.sample_rate);
+                memo.0 = Some((key, g));
+                g
+            }
+        };
+        let requested_k = self.pow2[0].of(self.stiffness.value + k_octaves) * tuning;
+        let requested_z = self.pow2[1].of(self.damping.value + z_octaves) * z_factor;
         let mut moved = [(view.envelope, 0.0); NUM_MACROS];
         let mut n_moved = 0;
         for (slot, (binding, envs)) in view.macros.iter().zip(view.macro_envelopes).enumerate() {
             if let (Some(b), Some((low, high))) = (binding, envs) {
-                let v = b.value_at(self.macros[slot].value);
+                let v = self.macro_values[slot].of(b, self.macros[slot].value);
                 let (env, f) = if v > b.default && b.max > b.default {
                     (high, (v - b.default) / (b.max - b.default))
                 } else if v < b.default && b.min < b.default {
@@ -275,7 +354,10 @@ impl Smoothed {
         engine.set_class_gain(ScaleClass::Damping, gains.damping);
         for (slot, binding) in macros.iter().enumerate() {
             if let Some(b) = binding {
-                engine.set_param(b.param, b.value_at(self.macros[slot].value));
+                engine.set_param(
+                    b.param,
+                    self.macro_values[slot].of(b, self.macros[slot].value),
+                );
             }
         }
     }

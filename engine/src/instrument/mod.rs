@@ -100,7 +100,7 @@ fn tune_voice(
             return g;
         }
     }
-    let g = smoothed.gains_offset(view, note_st, z, v.mod_k, v.mod_z);
+    let g = smoothed.gains_offset(view, note_st, z, v.mod_k, v.mod_z, &mut v.tuning);
     v.tuned = Some((key, g));
     smoothed.set(&mut bank.copy(i), view.macros, &g);
     g

@@ -13,7 +13,7 @@
 //! rest does not matter: gravity and contacts leave static offsets (a dropped mass lies on its
 //! triangle, away from where it started).
 
-use super::controls::{Controlled, Gains, TuneKey};
+use super::controls::{Controlled, Gains, TuneKey, TuningMemo};
 use super::CHUNK;
 use crate::lanes::{LaneEngine, LANES};
 use crate::{Engine, ParamId, ScaleClass};
@@ -70,6 +70,8 @@ pub struct Voice {
     pub strike: f64,
     /// What the voice was last tuned with, and the gains that gave (see `tune_voice`).
     pub tuned: Option<(TuneKey, Gains)>,
+    /// The tuning gain of the voice's last pitch (see `Smoothed::gains_offset`).
+    pub tuning: TuningMemo,
 }
 
 /// A voice that ended, for the host (CLAP voice-terminated events).
@@ -174,6 +176,7 @@ impl VoiceBank {
             fade_step: 0.0,
             strike: 0.0,
             tuned: None,
+            tuning: TuningMemo::default(),
         };
         VoiceBank {
             voices: vec![voice; capacity],
