@@ -516,6 +516,11 @@ fn apply(
     let mut i = 0;
     let mut c = 0;
     loop {
+        if g.reversed.get(c).copied().unwrap_or(false) {
+            // Reversed chains scatter here, with the links before the next chain.
+            c += 1;
+            continue;
+        }
         let (next, m, d) = match g.chains.get(c) {
             Some(&(start, len, d)) => (start as usize, len as usize, d as usize),
             None => (n, 0, 0),

@@ -167,6 +167,18 @@ fn each_lane_is_a_plain_engine_bit_for_bit() {
     lanes_equal_plain(&spec(MIXED), 48_000.0, k, z, strike);
     lanes_equal_plain(&spec(&chain_string()), 48_000.0, k, z, strike);
     lanes_equal_plain(&spec(&element_mesh()), 48_000.0, k, z, strike);
+    // Written from its far end: a reversed chain in the plain engine, scattered in lanes.
+    let forward = chain_string();
+    let reversed: String = forward
+        .lines()
+        .map(|l| match l.split_whitespace().collect::<Vec<_>>()[..] {
+            [label, "springDamper", a, b, k, z] => {
+                format!("{label} springDamper {b} {a} {k} {z}\n")
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    lanes_equal_plain(&spec(&reversed), 48_000.0, k, z, strike);
     lanes_equal_plain(&preset("drunk-triangles.mdl"), 48_000.0, k, z, strike);
     lanes_equal_plain(
         &preset("drunk-triangles.mdl"),

@@ -23,6 +23,9 @@ pub(crate) struct Group {
     /// Per chain: an argument is audio-rate (it may change within a block) or a column
     /// mixes scaling classes: never uniform.
     pub varying: Vec<bool>,
+    /// Per chain: its links are written the other way round, link j = (q + j + d, q + j)
+    /// (a string written from its far end); see [`Group::apply`].
+    pub reversed: Vec<bool>,
     /// Per chain: the number of chains, this one first, that are the rows of one mesh (see
     /// [`Group::find_rows`]); 0 when it starts none.
     pub rows: Vec<u32>,
@@ -48,23 +51,29 @@ impl Group {
         self.chains.clear();
         let n = self.len();
         let mut i = 0;
+        let mut reversed = Vec::new();
         while i < n {
-            let d = self.b[i].wrapping_sub(self.a[i]);
-            let mut end = i;
-            while end < n
-                && d >= 1
-                && self.b[end].wrapping_sub(self.a[end]) == d
-                && (end == i || self.a[end] == self.a[end - 1] + 1)
-            {
-                end += 1;
+            // Forward links (q + j, q + j + d), or reversed ones (q + j + d, q + j).
+            for (lo, hi, flip) in [(&self.a, &self.b, false), (&self.b, &self.a, true)] {
+                let d = hi[i].wrapping_sub(lo[i]);
+                let mut end = i;
+                while end < n
+                    && (1..u32::MAX / 2).contains(&d)
+                    && hi[end].wrapping_sub(lo[end]) == d
+                    && (end == i || lo[end] == lo[end - 1] + 1)
+                {
+                    end += 1;
+                }
+                if end - i >= MIN_CHAIN {
+                    self.chains.push((i as u32, (end - i) as u32, d));
+                    reversed.push(flip);
+                    i = end - 1;
+                    break;
+                }
             }
-            if end - i >= MIN_CHAIN {
-                self.chains.push((i as u32, (end - i) as u32, d));
-                i = end;
-            } else {
-                i += 1;
-            }
+            i += 1;
         }
+        self.reversed = reversed;
         self.uniform = vec![false; self.chains.len()];
         self.varying = vec![false; self.chains.len()];
         self.rows = vec![0; self.chains.len()];
@@ -88,10 +97,11 @@ impl Group {
             let (start, m, d) = self.chains[c];
             let q = self.a[start as usize];
             let mut end = c + 1;
-            while end < n && d == 1 {
+            while end < n && d == 1 && !self.reversed[c] {
                 let (s2, m2, d2) = self.chains[end];
                 let k = (end - c) as u32;
                 if d2 != 1
+                    || self.reversed[end]
                     || m2 != m
                     || s2 != start + k * m
                     || self.a[s2 as usize] != q + k * (m + 1)
@@ -220,6 +230,46 @@ impl Group {
                 fs[total] += s[total - 1];
                 i = start + rows * m;
                 c += rows;
+                continue;
+            }
+            if self.reversed.get(c).copied().unwrap_or(false) {
+                // Link j = (q + j + d, q + j), q its lower point: Δx = x[q + j + d] − x[q + j],
+                // F[q + j + d] −= s_j, F[q + j] += s_j. Point q + t receives −s_{t−d} (first
+                // end of link t − d) and then +s_t (second end of link t), in list order:
+                // F ← (F − s_{t−d}) + s_t, the scatter's arithmetic.
+                let q = b[start] as usize;
+                let (xl, xh) = (&x[q..q + m], &x[q + d..q + d + m]);
+                let (xpl, xph) = (&xp[q..q + m], &xp[q + d..q + d + m]);
+                let s = &mut scratch[..m];
+                if uniform && m >= UNIFORM_MIN {
+                    for j in 0..m {
+                        let dx = xh[j] - xl[j];
+                        let dv = (xh[j] - xph[j]) - (xl[j] - xpl[j]);
+                        s[j] = law(start, dx, dv);
+                    }
+                } else {
+                    for j in 0..m {
+                        let dx = xh[j] - xl[j];
+                        let dv = (xh[j] - xph[j]) - (xl[j] - xpl[j]);
+                        s[j] = law(start + j, dx, dv);
+                    }
+                }
+                let fs = &mut f[q..q + m + d];
+                for t in 0..m.min(d) {
+                    fs[t] += s[t];
+                }
+                if m > d {
+                    let (both, s_before) = (&mut fs[d..m], &s[..m - d]);
+                    let s_now = &s[d..m];
+                    for t in 0..m - d {
+                        both[t] = (both[t] - s_before[t]) + s_now[t];
+                    }
+                }
+                for t in m.max(d)..m + d {
+                    fs[t] -= s[t - d];
+                }
+                i = start + m;
+                c += 1;
                 continue;
             }
             let (xa, xb) = (&x[q..q + m], &x[q + d..q + d + m]);

@@ -25,6 +25,36 @@ mod tests {
         text += "@x springDamper @m3 @m30 0.05 0.\n@c contact @m10 @m20 0.05 0.001 0.\n";
         text += "@l40 springDamper @m39 @g1 0.1 0.001\n@in1 frcInput @m7\n@out1 posOutput @m25\n";
         assert!(!chain_and_scatter_agree(&text, 1));
+        // Strings written from their far end (links (i + 1, i)), short and long (the long one
+        // uniform), and a mesh whose links between rows are written upwards (d = 5).
+        for len in [40, 100] {
+            let mut text = String::from("@g0 ground 0.\n@g1 ground 0.\n");
+            for i in 0..len {
+                text += &format!("@m{i} mass 1. 0. 0.\n");
+            }
+            text += "@l0 springDamper @m0 @g0 0.1 0.001\n";
+            for i in 0..len - 1 {
+                text += &format!("@l{} springDamper @m{} @m{i} 0.1 0.001\n", i + 1, i + 1);
+            }
+            text += &format!("@e springDamper @g1 @m{} 0.1 0.001\n", len - 1);
+            text += "@in1 frcInput @m7\n@out1 posOutput @m25\n";
+            assert!(!chain_and_scatter_agree(&text, 1));
+        }
+        let (len, w) = (6, 5);
+        let mut text = String::from("@g ground 0.\n");
+        for i in 0..len * w {
+            text += &format!("@n{i} mass 1. 0. 0.\n");
+        }
+        for i in 0..len * w {
+            if i % w != w - 1 {
+                text += &format!("@h{i} springDamper @n{i} @n{} 0.1 0.001\n", i + 1);
+            }
+        }
+        for i in 0..(len - 1) * w {
+            text += &format!("@v{i} springDamper @n{} @n{i} 0.1 0.001\n", i + w);
+        }
+        text += "@p springDamper @g @n0 0.1 0.001\n@in1 frcInput @n7\n@out1 posOutput @n22\n";
+        chain_and_scatter_agree(&text, w as u32);
         // A 7 × 6 mesh written element by element: rows (d = 1), then the links between rows
         // (d = 6), with a corner pinned to a ground. Its rows run as one chain over all their
         // points, unless one row link reads other arguments.
@@ -50,6 +80,42 @@ mod tests {
             let merged = chain_and_scatter_agree(&text, w as u32);
             assert_eq!(merged, odd.is_none());
         }
+    }
+
+    /// A string written from its far end (every link (i + 1, i)) is the same string: each
+    /// link's force is the exact negation and every point sums the same terms in the same
+    /// order, so it plays the forward string's samples bit for bit. (Before reversed chains
+    /// were recognised, four such links in a row were taken for a chain with a wrapped-around
+    /// offset, and `process` panicked on an index out of range.)
+    #[test]
+    fn a_string_written_backwards_plays_the_same_samples() {
+        let string = |backwards: bool| {
+            let mut text = String::from("@g0 ground 0.\n");
+            for i in 1..=100 {
+                text += &format!("@n{i} mass 1. 0. 0.\n");
+            }
+            text += "@n101 ground 0.\n";
+            for i in 0..=100 {
+                let (a, b) = if backwards { (i + 1, i) } else { (i, i + 1) };
+                let (a, b) = (format!("n{a}"), format!("n{b}"));
+                let (a, b) = (a.replace("n0", "g0"), b.replace("n0", "g0"));
+                text += &format!("@l{i} springDamper @{a} @{b} 0.1 0.001\n");
+            }
+            text + "@in1 frcInput @n33\n@out1 posOutput @n66\n"
+        };
+        let render = |text: String| {
+            let spec = parse(&text).spec.expect("parses");
+            let mut e = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
+            let mut input = vec![0.0; 4096];
+            input[0] = 1.0;
+            let mut out = vec![0.0; 4096];
+            e.process(4096, &input, &mut out);
+            assert!(e.interactions.linear.chains.iter().any(|c| c.1 >= 64));
+            out.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        };
+        let forward = render(string(false));
+        assert!(forward.iter().any(|&b| f64::from_bits(b).abs() > 1e-4));
+        assert_eq!(forward, render(string(true)));
     }
 
     /// Plain masses (a = 2, b = −1, g = +0) run their own loop; the general update is its
@@ -202,6 +268,12 @@ mod tests {
         let mut chained = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
         let bands = &chained.interactions.linear.chains;
         assert!(bands.iter().any(|b| b.2 == widest), "{bands:?}");
+        // Every link of these models is in a band, whichever way it is written.
+        let in_bands: u32 = bands.iter().map(|b| b.1).sum();
+        assert!(
+            in_bands as usize + 3 >= chained.interactions.linear.len(),
+            "{bands:?}"
+        );
         let mut reference = chained.clone();
         reference.interactions.linear.chains.clear();
         let merged = chained.interactions.linear.rows_uniform.contains(&true);
