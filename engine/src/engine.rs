@@ -18,10 +18,10 @@
 //! Names never reach this module's hot paths; there is no per-element `match`.
 
 use crate::control::{Changed, ControlArgs};
+pub use crate::display::{IoKind, IoPoint};
 use crate::expr::{ExprRef, Program};
 use crate::info::ModelInfo;
 pub(crate) use crate::kernels::masses::{single_law, SingleMasses};
-use crate::laws;
 use crate::motion::MotionStore;
 use crate::spec::ScaleClass;
 use std::sync::Arc;
@@ -45,232 +45,9 @@ struct BlockIo<'a> {
     out_channels: usize,
 }
 
-/// The argument slots of one macro in `Engine::args`: M, K, K2 (stiff strings), Z, Zo.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct MacroSlots {
-    pub m: usize,
-    pub k: usize,
-    pub k2: usize,
-    pub z: usize,
-    pub zo: usize,
-}
-
-/// A string, chain or stiff string occupying points `base..base+len`.
-#[derive(Clone, Debug)]
-pub(crate) struct LineMacro {
-    pub base: usize,
-    pub len: usize,
-    /// Strings and stiff strings: nodes 0 and N−1 never move.
-    pub fixed_ends: bool,
-    pub slots: MacroSlots,
-}
-
-/// A mesh of `length × width` nodes at `base..`, node index i·W + j (spec §2.7.4).
-#[derive(Clone, Debug)]
-pub(crate) struct MeshMacro {
-    pub base: usize,
-    pub length: usize,
-    pub width: usize,
-    /// Local indices of pinned nodes (corners or border).
-    pub pinned: Vec<u32>,
-    pub slots: MacroSlots,
-}
-
-/// The per-step coefficients of the ground-friction node law of spec §2.7:
-/// X[n+1] = (2 − Zo/M)·X + (Zo/M − 1)·X̃ + F/M.
-#[inline(always)]
-pub(crate) fn node_law(m: f64, zo: f64) -> (f64, f64, f64) {
-    let zm = zo / m;
-    (2.0 - zm, zm - 1.0, 1.0 / m)
-}
-
-/// Stage 2 b: all macro structures. Each updates its nodes, then adds its internal forces.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Macros {
-    pub lines: Vec<LineMacro>,
-    pub stiff: Vec<LineMacro>,
-    pub meshes: Vec<MeshMacro>,
-    /// Node velocities x − x̃ of the macro being computed (sized for the largest macro).
-    pub scratch_v: Vec<f64>,
-    /// Link forces of the macro being computed.
-    pub scratch_s: Vec<f64>,
-}
-
-impl Macros {
-    #[inline(always)]
-    fn step(&mut self, p: &mut Points, args: &[f64]) {
-        let (v, s) = (&mut self.scratch_v, &mut self.scratch_s);
-        for mac in &self.lines {
-            let range = mac.base..mac.base + mac.len;
-            let x = &mut p.x[range.clone()];
-            let xp = &mut p.xp[range.clone()];
-            let f = &mut p.f[range];
-            update_line_nodes(mac, x, xp, f, args);
-            chain_links(x, xp, f, v, s, args[mac.slots.k], args[mac.slots.z]);
-        }
-        for mac in &self.stiff {
-            let range = mac.base..mac.base + mac.len;
-            let x = &mut p.x[range.clone()];
-            let xp = &mut p.xp[range.clone()];
-            let f = &mut p.f[range];
-            update_line_nodes(mac, x, xp, f, args);
-            chain_links(x, xp, f, v, s, args[mac.slots.k], args[mac.slots.z]);
-            stiffness_links(x, f, args[mac.slots.k2]);
-        }
-        for mac in &self.meshes {
-            let n = mac.length * mac.width;
-            let range = mac.base..mac.base + n;
-            let x = &mut p.x[range.clone()];
-            let xp = &mut p.xp[range.clone()];
-            let f = &mut p.f[range];
-            crate::kernels::mesh::mesh_step(mac, x, xp, f, v, s, args);
-        }
-    }
-}
-
-/// Moves the nodes of a line macro with the node law; fixed ends keep x = x̃ = X₀. Every
-/// node's force is reset.
-#[inline(always)]
-fn update_line_nodes(mac: &LineMacro, x: &mut [f64], xp: &mut [f64], f: &mut [f64], args: &[f64]) {
-    let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
-    let n = x.len();
-    let (lo, hi) = if mac.fixed_ends {
-        (1, n.saturating_sub(1))
-    } else {
-        (0, n)
-    };
-    for i in lo..hi {
-        let next = a * x[i] + b * xp[i] + f[i] * inv_m;
-        xp[i] = x[i];
-        x[i] = next;
-    }
-    f.fill(0.0);
-}
-
-/// The N−1 spring-dampers (i, i+1) of a line macro (spec §2.7.1–§2.7.3). The node forces are
-/// zero on entry, so F_i = (0 + s_{i−1}) − s_i: the same sum, in the same order, as applying the
-/// links one by one in script order.
-#[inline(always)]
-fn chain_links(x: &[f64], xp: &[f64], f: &mut [f64], v: &mut [f64], s: &mut [f64], k: f64, z: f64) {
-    let n = x.len();
-    if n < 2 {
-        return;
-    }
-    let v = &mut v[..n];
-    for i in 0..n {
-        v[i] = x[i] - xp[i];
-    }
-    let s = &mut s[..n - 1];
-    for i in 0..n - 1 {
-        s[i] = laws::spring_damper(x[i] - x[i + 1], v[i] - v[i + 1], k, z);
-    }
-    f[0] = -s[0];
-    for i in 1..n - 1 {
-        f[i] = s[i - 1] - s[i];
-    }
-    f[n - 1] = s[n - 2];
-}
-
-/// The stiff string's undamped K₂ springs (spec §2.7.3): f = K₂(x_a − x_b) for
-/// a = clip(i, 0, N−1), b = clip(i+2, 0, N−1), i = −1..N−1, applied in that order.
-#[inline(always)]
-fn stiffness_links(x: &[f64], f: &mut [f64], k2: f64) {
-    let n = x.len() as isize;
-    for i in -1..n {
-        let a = i.clamp(0, n - 1) as usize;
-        let b = (i + 2).clamp(0, n - 1) as usize;
-        let t = k2 * (x[a] - x[b]);
-        f[a] -= t;
-        f[b] += t;
-    }
-}
-
-/// Connection points (spec §2.8), points `base..base+len`: massless points interpolated from up
-/// to four macro nodes, whose force is spread back with the same weights.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Proxies {
-    pub base: usize,
-    pub nodes: Vec<[u32; 4]>,
-    pub weights: Vec<[f64; 4]>,
-    /// The macro each proxy addresses: first node, length and width (width 0 for 1-D).
-    pub geometry: Vec<(u32, u32, u32)>,
-    /// Argument slots of the coordinates (α, or u and w).
-    pub coord_slots: Vec<[usize; 2]>,
-}
-
-impl Proxies {
-    pub fn len(&self) -> usize {
-        self.nodes.len()
-    }
-
-    /// Recomputes the nodes and weights of proxy `i` from its coordinates (spec §2.8).
-    pub fn derive(&mut self, i: usize, args: &[f64]) {
-        /// Clamped position along `n` nodes: (lower node, upper node, fraction).
-        fn along(c: f64, n: u32) -> (u32, u32, f64) {
-            let last = n.saturating_sub(1);
-            // NaN coordinates count as 0.
-            let c = if c >= 0.0 { c.min(1.0) } else { 0.0 };
-            let p = c * last as f64;
-            let lo = (p.floor() as u32).min(last);
-            let hi = (lo + 1).min(last);
-            (lo, hi, p - lo as f64)
-        }
-        let (base, length, width) = self.geometry[i];
-        let [s0, s1] = self.coord_slots[i];
-        if width == 0 {
-            let (m1, m2, a) = along(args[s0], length);
-            self.nodes[i] = [base + m1, base + m2, base + m1, base + m1];
-            self.weights[i] = [1.0 - a, a, 0.0, 0.0];
-        } else {
-            let (i1, i2, ai) = along(args[s0], length);
-            let (j1, j2, aj) = along(args[s1], width);
-            let node = |i: u32, j: u32| base + i * width + j;
-            self.nodes[i] = [node(i1, j1), node(i2, j1), node(i1, j2), node(i2, j2)];
-            self.weights[i] = [
-                (1.0 - ai) * (1.0 - aj),
-                ai * (1.0 - aj),
-                (1.0 - ai) * aj,
-                ai * aj,
-            ];
-        }
-    }
-
-    /// The interpolated position of proxy `i`: Σ w·x_node (spec §2.8).
-    #[inline(always)]
-    fn interpolate(&self, i: usize, x: &[f64]) -> f64 {
-        let [n0, n1, n2, n3] = self.nodes[i];
-        let [w0, w1, w2, w3] = self.weights[i];
-        w0 * x[n0 as usize] + w1 * x[n1 as usize] + w2 * x[n2 as usize] + w3 * x[n3 as usize]
-    }
-
-    /// Stage 3: x̃_P ← x_P, x_P ← Σ w·x_node. The force slot is cleared here, after stage 6 of
-    /// the previous step read it (it holds F_P for `frcOutput`, spec §3.12 e).
-    #[inline(always)]
-    fn update_positions(&self, p: &mut Points) {
-        for i in 0..self.len() {
-            let pos = self.interpolate(i, &p.x);
-            let k = self.base + i;
-            p.xp[k] = p.x[k];
-            p.x[k] = pos;
-            p.f[k] = 0.0;
-        }
-    }
-
-    /// Stage 5: spread F_P onto the macro nodes, in creation order.
-    #[inline(always)]
-    fn spread_forces(&self, p: &mut Points) {
-        for i in 0..self.len() {
-            let fp = p.f[self.base + i];
-            let nodes = self.nodes[i];
-            let weights = self.weights[i];
-            for (n, w) in nodes.iter().zip(weights) {
-                p.f[*n as usize] += w * fp;
-            }
-        }
-    }
-}
-
 pub(crate) use crate::kernels::links::{Group, Interactions};
+pub(crate) use crate::kernels::macros::{node_law, LineMacro, MacroSlots, Macros, MeshMacro};
+pub(crate) use crate::kernels::proxies::Proxies;
 
 /// A signal routed between a 0-based channel and a point or parameter slot.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -334,25 +111,6 @@ pub struct GuardEvent {
     pub point: Option<u32>,
     /// The output channel (0-based) that went bad, when it was an output.
     pub output: Option<u32>,
-}
-
-/// What an [`IoPoint`] is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum IoKind {
-    ForceInput,
-    PositionInput,
-    PositionOutput,
-    ForceOutput,
-}
-
-/// A model input or output located on a material point (see [`Engine::io_points`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct IoPoint {
-    pub kind: IoKind,
-    /// The 1-based channel (`@in1` / `@out1` is 1).
-    pub channel: u32,
-    /// Index in the generic motion buffer.
-    pub point: u32,
 }
 
 /// Why the guard tripped.
@@ -639,76 +397,6 @@ impl Engine {
     /// Force accumulators, in the order of [`Engine::positions`].
     pub fn forces(&self) -> &[f64] {
         &self.points.f
-    }
-
-    /// The material point a point index stands for in a display: itself for a material
-    /// point, the node with the largest weight for a connection point (spec §2.8).
-    fn display_point(&self, index: u32) -> Option<u32> {
-        let i = index as usize;
-        if i < self.info.num_points {
-            return Some(index);
-        }
-        let p = i.checked_sub(self.proxies.base)?;
-        let (nodes, weights) = (self.proxies.nodes.get(p)?, self.proxies.weights.get(p)?);
-        let best = (0..4).max_by(|&a, &b| weights[a].total_cmp(&weights[b]))?;
-        Some(nodes[best])
-    }
-
-    /// Where the model's inputs and outputs sit, for displays (spec §6): one entry per force
-    /// input, position input (its avatar), position output and force output, located on a
-    /// material point of the generic motion buffer.
-    pub fn io_points(&self) -> Vec<IoPoint> {
-        let mut out = Vec::new();
-        let mut push = |kind: IoKind, channel: u32, index: u32| {
-            if let Some(point) = self.display_point(index) {
-                out.push(IoPoint {
-                    kind,
-                    channel: channel + 1,
-                    point,
-                });
-            }
-        };
-        for r in &self.force_inputs {
-            push(IoKind::ForceInput, r.channel, r.index);
-        }
-        for r in &self.avatars {
-            push(IoKind::PositionInput, r.channel, r.index);
-        }
-        for r in &self.pos_outputs {
-            push(IoKind::PositionOutput, r.channel, r.index);
-        }
-        for &(channel, start, len) in &self.frc_outputs {
-            if let Some(&first) = self
-                .frc_sources
-                .get(start as usize..(start + len) as usize)
-                .and_then(|s| s.first())
-            {
-                push(IoKind::ForceOutput, channel, first);
-            }
-        }
-        out
-    }
-
-    /// The explicit interactions as pairs of material points (connection points replaced by
-    /// their heaviest node), for drawing a structure. Macro-internal links are not listed:
-    /// they join consecutive nodes of a string and neighbours of a mesh (spec §2.7).
-    pub fn links(&self) -> Vec<(u32, u32)> {
-        let i = &self.interactions;
-        [
-            &i.linear,
-            &i.contact,
-            &i.nl_contact,
-            &i.nl_spring2,
-            &i.nl_spring3,
-            &i.nl_spring_damper,
-            &i.pluck,
-            &i.bow,
-        ]
-        .iter()
-        .flat_map(|g| g.a.iter().zip(&g.b))
-        .filter_map(|(&a, &b)| Some((self.display_point(a)?, self.display_point(b)?)))
-        .filter(|(a, b)| a != b)
-        .collect()
     }
 
     /// Restores the initial state of spec §1.5 stage 0: positions from the current parameter

@@ -23,6 +23,7 @@
 
 pub mod compile;
 mod control;
+mod display;
 pub mod engine;
 pub mod expr;
 pub mod generators;

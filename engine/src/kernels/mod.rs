@@ -1,8 +1,10 @@
 //! Kernels of the sample loop that live in their own files, each with its equation.
 
 pub(crate) mod links;
+pub(crate) mod macros;
 pub(crate) mod masses;
 pub(crate) mod mesh;
+pub(crate) mod proxies;
 
 #[cfg(test)]
 mod tests {
