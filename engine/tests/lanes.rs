@@ -128,16 +128,23 @@ fn lanes_equal_plain(
 
 /// An element-by-element string: its links form a chain (`Group::apply`).
 fn chain_string() -> String {
+    long_string(24, None)
+}
+
+/// A string of `n` masses written element by element; link `odd` (if any) is stiffer, so
+/// the chain's links do not all read the same arguments.
+fn long_string(n: usize, odd: Option<usize>) -> String {
     let mut text = String::from("@g0 ground 0.\n@g1 ground 0.\n");
-    for i in 0..24 {
+    for i in 0..n {
         text += &format!("@m{i} mass 1. 0. 0.\n");
     }
     text += "@l0 springDamper @g0 @m0 0.1 0.001\n";
-    for i in 0..23 {
-        text += &format!("@l{} springDamper @m{i} @m{} 0.1 0.001\n", i + 1, i + 1);
+    for i in 0..n - 1 {
+        let k = if odd == Some(i) { 0.12 } else { 0.1 };
+        text += &format!("@l{} springDamper @m{i} @m{} {k} 0.001\n", i + 1, i + 1);
     }
-    text += "@l24 springDamper @m23 @g1 0.1 0.001\n@in1 frcInput @m5\n@out1 posOutput @m17\n";
-    text
+    text += &format!("@e springDamper @m{} @g1 0.1 0.001\n", n - 1);
+    text + "@in1 frcInput @m5\n@out1 posOutput @m17\n"
 }
 
 /// A 6 × 5 mesh written element by element: bands of links within rows and between them.
@@ -167,6 +174,9 @@ fn each_lane_is_a_plain_engine_bit_for_bit() {
     lanes_equal_plain(&spec(MIXED), 48_000.0, k, z, strike);
     lanes_equal_plain(&spec(&chain_string()), 48_000.0, k, z, strike);
     lanes_equal_plain(&spec(&element_mesh()), 48_000.0, k, z, strike);
+    // Long chains: uniform (the first link's arguments, per lane) and not.
+    lanes_equal_plain(&spec(&long_string(100, None)), 48_000.0, k, z, strike);
+    lanes_equal_plain(&spec(&long_string(100, Some(40))), 48_000.0, k, z, strike);
     // Written from its far end: a reversed chain in the plain engine, scattered in lanes.
     let forward = chain_string();
     let reversed: String = forward
