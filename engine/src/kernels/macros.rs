@@ -65,7 +65,7 @@ impl Macros {
             let xp = &mut p.xp[range.clone()];
             let f = &mut p.f[range];
             update_line_nodes(mac, x, xp, f, args);
-            chain_links(x, xp, f, v, s, args[mac.slots.k], args[mac.slots.z]);
+            chain_links(x, xp, f, s, args[mac.slots.k], args[mac.slots.z]);
         }
         for mac in &self.stiff {
             let range = mac.base..mac.base + mac.len;
@@ -73,7 +73,7 @@ impl Macros {
             let xp = &mut p.xp[range.clone()];
             let f = &mut p.f[range];
             update_line_nodes(mac, x, xp, f, args);
-            chain_links(x, xp, f, v, s, args[mac.slots.k], args[mac.slots.z]);
+            chain_links(x, xp, f, s, args[mac.slots.k], args[mac.slots.z]);
             stiffness_links(x, f, args[mac.slots.k2]);
         }
         for mac in &self.meshes {
@@ -87,8 +87,9 @@ impl Macros {
     }
 }
 
-/// Moves the nodes of a line macro with the node law; fixed ends keep x = x̃ = X₀. Every
-/// node's force is reset.
+/// Moves the nodes of a line macro with the node law; fixed ends keep x = x̃ = X₀. The node
+/// forces are left for `chain_links`, which assigns every one of them (a macro of one node
+/// has them reset here).
 #[inline(always)]
 fn update_line_nodes(mac: &LineMacro, x: &mut [f64], xp: &mut [f64], f: &mut [f64], args: &[f64]) {
     let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
@@ -103,25 +104,27 @@ fn update_line_nodes(mac: &LineMacro, x: &mut [f64], xp: &mut [f64], f: &mut [f6
         xp[i] = x[i];
         x[i] = next;
     }
-    f.fill(0.0);
+    if n < 2 {
+        f.fill(0.0);
+    }
 }
 
-/// The N−1 spring-dampers (i, i+1) of a line macro (spec §2.7.1–§2.7.3). The node forces are
-/// zero on entry, so F_i = (0 + s_{i−1}) − s_i: the same sum, in the same order, as applying the
-/// links one by one in script order.
+/// The N−1 spring-dampers (i, i+1) of a line macro (spec §2.7.1–§2.7.3). Every node force is
+/// assigned: F_i = s_{i−1} − s_i, which is (0 + s_{i−1}) − s_i, the same sum in the same order
+/// as applying the links one by one in script order to forces reset to 0. Velocities are
+/// taken where they are used, (x_i − x̃_i) − (x_{i+1} − x̃_{i+1}), the same operations as
+/// through a velocity array.
 #[inline(always)]
-fn chain_links(x: &[f64], xp: &[f64], f: &mut [f64], v: &mut [f64], s: &mut [f64], k: f64, z: f64) {
+fn chain_links(x: &[f64], xp: &[f64], f: &mut [f64], s: &mut [f64], k: f64, z: f64) {
     let n = x.len();
     if n < 2 {
         return;
     }
-    let v = &mut v[..n];
-    for i in 0..n {
-        v[i] = x[i] - xp[i];
-    }
     let s = &mut s[..n - 1];
+    let (xa, xb) = (&x[..n - 1], &x[1..n]);
+    let (xpa, xpb) = (&xp[..n - 1], &xp[1..n]);
     for i in 0..n - 1 {
-        s[i] = laws::spring_damper(x[i] - x[i + 1], v[i] - v[i + 1], k, z);
+        s[i] = laws::spring_damper(xa[i] - xb[i], (xa[i] - xpa[i]) - (xb[i] - xpb[i]), k, z);
     }
     f[0] = -s[0];
     for i in 1..n - 1 {
