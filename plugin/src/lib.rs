@@ -32,12 +32,14 @@ pub mod plot;
 pub mod presets;
 pub mod report;
 pub mod runtime;
+pub mod voices_watch;
 
 pub use ressort_engine::instrument::{dsp, envelope, host, macros};
 
 use params::RessortParams;
 use report::{HostLink, MainThreadTask};
 use runtime::RuntimeStatus;
+use voices_watch::VoicesWatch;
 
 /// Output and input below this count as silence for the host's sleep decision (−120 dBFS).
 const QUIET_LEVEL: f64 = 1e-6;
@@ -63,8 +65,10 @@ pub struct Ressort {
     quiet_samples: u64,
     /// A strike from the editor waits for the next block.
     pending_strike: bool,
-    /// A main-thread task to apply a new Voices setting is on its way.
+    /// A main-thread task to apply a new Voices setting is on its way (CLAP).
     voices_task_queued: bool,
+    /// Applies a new Voices setting in the other formats (started at the first activation).
+    voices_watch: Option<VoicesWatch>,
 }
 
 /// How `ressort-standalone` starts: its `--model` and `--audition` options.
@@ -110,6 +114,7 @@ impl Default for Ressort {
             quiet_samples: 0,
             pending_strike: false,
             voices_task_queued: false,
+            voices_watch: None,
         }
     }
 }
@@ -195,8 +200,8 @@ impl Ressort {
         self.pending_strike |= strike;
     }
 
-    /// A new Voices setting: CLAP re-prepares the model on the main thread at once; other
-    /// formats at the next activation or when the editor sees it.
+    /// A new Voices setting: CLAP re-prepares the model on the main thread at once; the
+    /// other formats through [`VoicesWatch`], within a few tens of milliseconds.
     fn follow_voices_setting(&mut self, context: &mut impl ProcessContext<Self>) {
         if !self.store.voices_stale() {
             self.voices_task_queued = false;
@@ -435,7 +440,7 @@ impl Plugin for Ressort {
         &mut self,
         audio_io_layout: &AudioIOLayout,
         buffer_config: &BufferConfig,
-        _context: &mut impl ActivateContext<Self>,
+        context: &mut impl ActivateContext<Self>,
     ) -> bool {
         let sr = buffer_config.sample_rate as f64;
         if !(sr.is_finite() && (1.0..=1e7).contains(&sr)) {
@@ -451,6 +456,9 @@ impl Plugin for Ressort {
         self.instrument.set_main_input(self.has_main_input);
         self.instrument.set_model(model);
         self.quiet_samples = 0;
+        if context.plugin_api() != PluginApi::Clap && self.voices_watch.is_none() {
+            self.voices_watch = VoicesWatch::start(self.store.clone());
+        }
         true
     }
 

@@ -179,6 +179,11 @@ pub struct ModelStore {
     voices_stale: AtomicBool,
     /// The A/B compare slots (not saved with the project).
     compare: Mutex<Compare>,
+    /// Held while a model is prepared for the audio thread or the plugin (de)activates, so
+    /// that a model compiled at one sample rate never arrives after an activation at another
+    /// (the editor, the host's main thread and the Voices watch all submit). Never taken by
+    /// the audio thread.
+    preparing: Mutex<()>,
     /// A copy of the running model for the editor's modal analysis, made when it was prepared.
     modal: Mutex<Option<Arc<ModalModel>>>,
     /// What the audio thread reports.
@@ -200,6 +205,7 @@ impl Default for ModelStore {
             garbage: crossbeam_channel::bounded(64),
             motion: Mutex::new(None),
             compare: Mutex::new(Compare::default()),
+            preparing: Mutex::new(()),
             modal: Mutex::new(None),
             voices: AtomicU64::new(0),
             voices_stale: AtomicBool::new(false),
@@ -274,6 +280,7 @@ impl ModelStore {
     /// [`ModelStore::activate`] compiles it. A script with errors changes nothing but the
     /// diagnostics.
     pub fn submit(&self, state: ModelState) -> Result<(), Rejected> {
+        let _preparing = lock(&self.preparing);
         self.collect_garbage();
         let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
         let result = if rate > 0.0 {
@@ -340,8 +347,8 @@ impl ModelStore {
         self.voices_stale.load(Ordering::Acquire)
     }
 
-    /// Re-prepares the running script with the current Voices setting (main thread; a
-    /// no-op while inactive or when nothing changed).
+    /// Re-prepares the running script with the current Voices setting (any thread but the
+    /// audio thread; a no-op while inactive or when nothing changed).
     pub fn apply_voices(&self) {
         if self.voices_stale.swap(false, Ordering::AcqRel) {
             let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
@@ -398,6 +405,7 @@ impl ModelStore {
     /// Compiles the running script for `sample_rate` at activation. When it cannot be
     /// compiled at this rate, the default preset runs instead and the diagnostics say why.
     pub fn activate(&self, sample_rate: f64) -> Option<Box<Prepared>> {
+        let _preparing = lock(&self.preparing);
         self.voices_stale.store(false, Ordering::Release);
         self.collect_garbage();
         while self.to_audio.1.try_recv().is_ok() {}
@@ -430,6 +438,7 @@ impl ModelStore {
 
     /// Marks the plugin inactive and frees what the audio thread returned.
     pub fn deactivate(&self) {
+        let _preparing = lock(&self.preparing);
         self.sample_rate.store(0, Ordering::Release);
         while self.to_audio.1.try_recv().is_ok() {}
         self.collect_garbage();

@@ -6,6 +6,7 @@ The bundle is the one the test command builds (`assert_process_allocs`: an alloc
 process() aborts the host process, so these tests also check that in JUCE hosts).
 """
 
+import time
 from pathlib import Path
 
 import dawdreamer as daw
@@ -165,6 +166,40 @@ def test_pedalboard_plays_a_chord_as_the_sum_of_its_notes(preset_dir):
     print(f"chord peak {level:.4f}, largest difference from the sum {error:.2e}")
     assert 1e-3 < level < 0.5
     assert error <= 1e-5 * level
+
+
+def test_pedalboard_hears_a_voices_change_without_reactivating(preset_dir):
+    # A DAW does not re-activate a plugin when a parameter moves. Voices set from 1 to 8 while
+    # the plugin runs (no reset in between) must play the chord as 8 voices do from the start:
+    # the VST3 wrapper runs no main-thread task for it, so the plugin's own thread applies it.
+    chord = [
+        mido.Message("note_on", note=k, velocity=100, time=0.25 * i)
+        for i, k in enumerate([60, 64, 67])
+    ]
+    silence = []
+
+    def play(plugin, change_voices):
+        plugin.reset()
+        plugin(silence, duration=0.2, sample_rate=SR)
+        if change_voices:
+            plugin.parameters["voices"].raw_value = 8 / 128
+            plugin(silence, duration=0.05, sample_rate=SR, reset=False)
+            time.sleep(0.5)
+        plugin(silence, duration=0.1, sample_rate=SR, reset=False)
+        return plugin(chord, duration=1.5, sample_rate=SR, reset=False)
+
+    changed = pedalboard.load_plugin(str(bundle()))
+    changed.load_preset(preset(preset_dir, "mono", STRUCK, voices=1, output_gain=-20.0))
+    played = play(changed, True)
+    assert changed.voices == "8"
+    fresh = pedalboard.load_plugin(str(bundle()))
+    fresh.load_preset(preset(preset_dir, "poly", STRUCK, voices=8, output_gain=-20.0))
+    expected = play(fresh, False)
+    level = np.abs(expected).max()
+    error = np.abs(played - expected).max()
+    print(f"chord peak {level:.4f}, largest difference from 8 voices from the start {error:.2e}")
+    assert 1e-3 < level < 0.5
+    assert error <= 1e-6 * level
 
 
 def test_pedalboard_restores_state_bit_identically_into_a_fresh_instance(preset_dir):
