@@ -10,8 +10,10 @@
 //!    spec §6.2;
 //! 3. **group into kinds** (`kinds`): single masses, macros, avatars, one group per interaction
 //!    law, inputs and outputs, every endpoint resolved to a point (connection points are
-//!    created here); the banding of linear links is to go here;
-//! 4. **bind arguments** (`bind`): argument slots and columns, compiled expressions, init runs;
+//!    created here);
+//! 4. **order into bands** (`bands`): each interaction group's links reordered so that its
+//!    bands (links (q + j, q + j + d)) lie next to each other, where that bands more of them;
+//! 5. **bind arguments** (`bind`): argument slots and columns, compiled expressions, init runs;
 //!
 //! then `assemble` lays out the motion buffers and builds the engine. Errors are reported by
 //! each pass in script order, pass after pass.
@@ -22,6 +24,7 @@ use crate::spec::{ModelSpec, SampleRateMode, REFERENCE_SAMPLE_RATE_HZ};
 use context::Cx;
 
 mod assemble;
+mod bands;
 mod bind;
 mod context;
 mod errors;
@@ -74,7 +77,8 @@ pub fn compile(spec: &ModelSpec, options: &CompileOptions) -> Result<Engine, Com
     let rate = cx.rate(options);
     let params = cx.resolve_labels();
     let numbering = cx.number_points();
-    let kinds = cx.group_into_kinds(&params, &numbering);
+    let mut kinds = cx.group_into_kinds(&params, &numbering);
+    kinds.links.order_into_bands();
     let bound = cx.bind_arguments(&kinds, &numbering, rate);
     cx.assemble(options, rate, params, numbering, kinds, bound)
 }

@@ -3,11 +3,7 @@
 //! endpoint and target to a point. A bracket endpoint creates a connection point, numbered after
 //! the material points in the order met. Nothing is bound here: the rows keep their argument
 //! expressions for the binding pass.
-//!
-//! Banding (issue 11, point 1) belongs here: [`LinkGroups`] is where the linear links, which
-//! today run as one gathered group in script order, would be split into bands of links
-//! (i, i + d) over contiguous point ranges, the links that fit no band staying on the general
-//! path.
+//! The next pass (`bands`) reorders each group's links into bands.
 
 use super::context::Cx;
 use super::errors::CompileErrorKind;
@@ -39,7 +35,7 @@ pub(super) const NUM_LAW_GROUPS: usize = 8;
 /// The number of argument columns of each interaction group, in [`law_row`] order.
 pub(super) const LAW_COLUMNS: [usize; NUM_LAW_GROUPS] = [2, 3, 5, 3, 3, 4, 3, 3];
 
-/// The links of a model by law group, each group in script order.
+/// The links of a model by law group, each group in script order (until `bands` reorders it).
 #[derive(Default)]
 pub(super) struct LinkGroups<'a> {
     pub groups: [Vec<Row<'a>>; NUM_LAW_GROUPS],

@@ -48,31 +48,8 @@ impl Group {
 
     /// Finds the bands (done once, when the model is compiled).
     pub fn find_chains(&mut self) {
-        self.chains.clear();
-        let n = self.len();
-        let mut i = 0;
-        let mut reversed = Vec::new();
-        while i < n {
-            // Forward links (q + j, q + j + d), or reversed ones (q + j + d, q + j).
-            for (lo, hi, flip) in [(&self.a, &self.b, false), (&self.b, &self.a, true)] {
-                let d = hi[i].wrapping_sub(lo[i]);
-                let mut end = i;
-                while end < n
-                    && (1..u32::MAX / 2).contains(&d)
-                    && hi[end].wrapping_sub(lo[end]) == d
-                    && (end == i || lo[end] == lo[end - 1] + 1)
-                {
-                    end += 1;
-                }
-                if end - i >= MIN_CHAIN {
-                    self.chains.push((i as u32, (end - i) as u32, d));
-                    reversed.push(flip);
-                    i = end - 1;
-                    break;
-                }
-            }
-            i += 1;
-        }
+        let (chains, reversed) = find_bands(&self.a, &self.b);
+        self.chains = chains;
         self.reversed = reversed;
         self.uniform = vec![false; self.chains.len()];
         self.varying = vec![false; self.chains.len()];
@@ -308,6 +285,37 @@ impl Group {
         }
         scatter(i, &a[i..], &b[i..], x, xp, f, &law);
     }
+}
+
+/// The bands of a link list (endpoints `a`, `b`), in list order: runs of at least
+/// [`MIN_CHAIN`] links j = (q + j, q + j + d), or reversed (q + j + d, q + j), as
+/// (start, len, d) and whether each is reversed.
+pub(crate) fn find_bands(a: &[u32], b: &[u32]) -> (Vec<(u32, u32, u32)>, Vec<bool>) {
+    let n = a.len();
+    let (mut chains, mut reversed) = (Vec::new(), Vec::new());
+    let mut i = 0;
+    while i < n {
+        // Forward links (q + j, q + j + d), or reversed ones (q + j + d, q + j).
+        for (lo, hi, flip) in [(a, b, false), (b, a, true)] {
+            let d = hi[i].wrapping_sub(lo[i]);
+            let mut end = i;
+            while end < n
+                && (1..u32::MAX / 2).contains(&d)
+                && hi[end].wrapping_sub(lo[end]) == d
+                && (end == i || lo[end] == lo[end - 1] + 1)
+            {
+                end += 1;
+            }
+            if end - i >= MIN_CHAIN {
+                chains.push((i as u32, (end - i) as u32, d));
+                reversed.push(flip);
+                i = end - 1;
+                break;
+            }
+        }
+        i += 1;
+    }
+    (chains, reversed)
 }
 
 /// Links `first..first + a.len()` of a group, one by one: F₁ −= f, F₂ += f.

@@ -120,6 +120,77 @@ mod tests {
         assert_eq!(forward, render(string(true)));
     }
 
+    /// The compiler's band pass (`compile/bands.rs`): a mesh whose links are written in any
+    /// order runs every link in a band, and plays what the mesh written row by row plays to
+    /// rounding (only the order of the sums into F differs, spec §1.5). The row-by-row mesh,
+    /// banded as written, keeps its script order.
+    #[test]
+    fn a_mesh_written_in_any_link_order_runs_in_bands() {
+        let (rows, cols) = (12usize, 10usize);
+        let id = |r: usize, c: usize| r * cols + c;
+        let mut links = Vec::new();
+        for r in 0..rows {
+            for c in 0..cols - 1 {
+                links.push((id(r, c), id(r, c + 1)));
+            }
+        }
+        for r in 0..rows - 1 {
+            for c in 0..cols {
+                links.push((id(r, c), id(r + 1, c)));
+            }
+        }
+        let mesh = |links: &[(usize, usize)]| {
+            let mut text = String::new();
+            for p in 0..rows * cols {
+                let corner = (p == 0) || (p == rows * cols - 1);
+                text += &if corner {
+                    format!("@p{p} ground 0.\n")
+                } else {
+                    format!("@p{p} mass 1. 0. 0.\n")
+                };
+            }
+            for (k, (a, b)) in links.iter().enumerate() {
+                text += &format!("@l{k} springDamper @p{a} @p{b} 0.1 0.001\n");
+            }
+            text + "@in1 frcInput @p23\n@out1 posOutput @p77\n"
+        };
+        let run = |links: &[(usize, usize)]| {
+            let spec = parse(&mesh(links)).spec.expect("parses");
+            let mut e = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
+            let g = &e.interactions.linear;
+            let banded: u32 = g.chains.iter().map(|c| c.1).sum();
+            assert_eq!(banded as usize, g.len(), "every link in a band");
+            let order: Vec<(u32, u32)> = g.a.iter().copied().zip(g.b.iter().copied()).collect();
+            let frames = 8192;
+            let mut input = vec![0.0; frames];
+            input[0] = 1.0;
+            let mut out = vec![0.0; frames];
+            e.process(frames, &input, &mut out);
+            (out, order)
+        };
+        let (written, order) = run(&links);
+        let as_written: Vec<(u32, u32)> = links.iter().map(|&(a, b)| (a as u32, b as u32)).collect();
+        assert_eq!(order, as_written);
+        // The same links shuffled (a fixed linear congruential sequence), some reversed.
+        let mut shuffled = links.clone();
+        let mut state = 12345u64;
+        for i in (1..shuffled.len()).rev() {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            shuffled.swap(i, (state >> 33) as usize % (i + 1));
+            if state & 1 == 1 {
+                shuffled[i] = (shuffled[i].1, shuffled[i].0);
+            }
+        }
+        let (any_order, _) = run(&shuffled);
+        let peak = written.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = written
+            .iter()
+            .zip(&any_order)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(peak > 1e-4);
+        assert!(diff <= 1e-9 * peak, "{diff:e} of {peak:e}");
+    }
+
     /// Any network: runs of links forwards, backwards, with any offset, broken runs, rows,
     /// mixed with stray links and a contact, with shared or differing stiffness. The
     /// interaction kernels (chains, reversed chains, uniform chains, mesh rows) play what
