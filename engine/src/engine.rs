@@ -23,6 +23,8 @@ use crate::expr::{ExprRef, Program};
 use crate::info::ModelInfo;
 pub(crate) use crate::kernels::masses::{single_law, SingleMasses};
 use crate::motion::MotionStore;
+pub use crate::guard::{GuardEvent, GuardKind};
+pub(crate) use crate::rest::Rest;
 use crate::spec::ScaleClass;
 use std::sync::Arc;
 
@@ -98,28 +100,6 @@ pub(crate) struct InitRun {
     pub count: u32,
     pub x0: ExprRef,
     pub rule: InitRule,
-}
-
-/// What the runtime guard saw (spec §3.12 f; issue: stability guard).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GuardEvent {
-    /// The sample, counted from the last reset, at which the problem was seen.
-    pub sample: u64,
-    pub kind: GuardKind,
-    /// The point (index in [`ModelInfo::points`], or a connection point beyond them) whose
-    /// position went bad, when known.
-    pub point: Option<u32>,
-    /// The output channel (0-based) that went bad, when it was an output.
-    pub output: Option<u32>,
-}
-
-/// Why the guard tripped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum GuardKind {
-    /// A position or output became NaN or infinite.
-    NonFinite,
-    /// A position or output exceeded [`Engine::position_limit`].
-    Runaway,
 }
 
 /// The default runaway limit on positions and outputs, in model units. Reference models move
@@ -200,6 +180,8 @@ pub struct Engine {
     pub(crate) motion: Option<Arc<MotionStore>>,
     pub(crate) motion_interval: u32,
     pub(crate) motion_counter: u32,
+    /// Whether the state is known to be a fixed point of the sample loop ([`Rest`]).
+    pub(crate) rest: Rest,
     /// The instruction set the sample loop runs with, detected once: the loop is compiled for
     /// the baseline and for AVX2 (pulp's x86-v3), and [`Engine::process`] picks one per block.
     /// Without FMA contraction both give the same IEEE operations, so the same samples.
@@ -210,6 +192,9 @@ pub struct Engine {
 /// instruction set's `#[target_feature]` entry point, and with it the whole sample loop.
 struct Block<'a> {
     engine: &'a mut Engine,
+    /// The samples `start..end` of a block of `frames`.
+    start: usize,
+    end: usize,
     frames: usize,
     inputs: &'a [f64],
     in_channels: usize,
@@ -223,6 +208,7 @@ impl pulp::WithSimd for Block<'_> {
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) -> usize {
         self.engine.run(
+            self.start..self.end,
             self.frames,
             self.inputs,
             self.in_channels,
@@ -432,6 +418,7 @@ impl Engine {
         }
         self.flush_tiny();
         self.guard = None;
+        self.rest = Rest::Moving;
         self.samples_since_reset = 0;
         self.motion_counter = 0;
     }
@@ -538,19 +525,55 @@ impl Engine {
         outputs[..out_channels * frames].fill(0.0);
         if self.params_dirty {
             self.refresh_control();
+            self.rest = Rest::Moving;
         }
         let was_tripped = self.guard.is_some();
         let mut simulated = 0;
         if !was_tripped {
+            // Silent: every input sample reads as +0 (non-finite ones count as 0), and no
+            // motion store wants the frames written.
+            let silent = self.motion.is_none()
+                && inputs[..in_channels * frames]
+                    .iter()
+                    .all(|v| v.to_bits() == 0 || !v.is_finite());
+            if !silent {
+                self.rest = Rest::Moving;
+            }
             let arch = self.arch;
-            simulated = arch.dispatch(Block {
-                engine: self,
-                frames,
-                inputs,
-                in_channels,
-                outputs,
-                out_channels,
-            });
+            let block = |engine: &mut Engine, outputs: &mut [f64], start: usize, end: usize| {
+                arch.dispatch(Block {
+                    engine,
+                    start,
+                    end,
+                    frames,
+                    inputs,
+                    in_channels,
+                    outputs,
+                    out_channels,
+                })
+            };
+            let mut start = 0;
+            if self.rest == Rest::Still && frames > 0 {
+                // Still after a silent sample: one more decides whether this is a fixed point.
+                simulated = block(self, outputs, 0, 1);
+                start = 1;
+                self.rest = if self.guard.is_none() && self.stationary() {
+                    Rest::Fixed
+                } else {
+                    Rest::Moving
+                };
+            }
+            if self.guard.is_none() && start < frames {
+                simulated = if self.rest == Rest::Fixed {
+                    self.hold(start, frames, outputs, out_channels)
+                } else {
+                    let n = block(self, outputs, start, frames);
+                    if silent && self.guard.is_none() && self.stationary() {
+                        self.rest = Rest::Still;
+                    }
+                    n
+                };
+            }
             if self.guard.is_none() {
                 self.scan_positions();
             }
@@ -570,6 +593,7 @@ impl Engine {
     #[inline(always)]
     fn run(
         &mut self,
+        samples: std::ops::Range<usize>,
         frames: usize,
         inputs: &[f64],
         in_channels: usize,
@@ -583,15 +607,16 @@ impl Engine {
             out_channels,
         };
         let scale = self.class_factors();
-        let mut n = 0;
-        while n < frames {
+        let mut n = samples.start;
+        let frames_end = samples.end;
+        while n < frames_end {
             let watched = self.motion.is_some();
             let until_write = match (watched, self.motion_counter) {
-                (false, _) => frames,
+                (false, _) => frames_end,
                 (true, 0) => 0,
                 (true, c) => (self.motion_interval - c) as usize,
             };
-            let end = frames.min(n + until_write);
+            let end = frames_end.min(n + until_write);
             for k in n..end {
                 if self.sample::<false>(k, &io, outputs, &scale) {
                     return k + 1;
@@ -602,7 +627,7 @@ impl Engine {
                     % self.motion_interval as usize) as u32;
             }
             n = end;
-            if n < frames && watched {
+            if n < frames_end && watched {
                 // The counter is 0: this sample writes the motion buffers.
                 if self.sample::<true>(n, &io, outputs, &scale) {
                     return n + 1;
@@ -611,7 +636,7 @@ impl Engine {
                 n += 1;
             }
         }
-        frames
+        frames_end
     }
 
     /// Sample `n` of a block: stages 1 to 7, the guard's check and the periodic flush.
@@ -701,7 +726,7 @@ impl Engine {
     /// Stage 6: writes frame `n` of every output. Returns the first bad value's kind and
     /// channel, if any.
     #[inline(always)]
-    fn write_outputs(
+    pub(crate) fn write_outputs(
         &self,
         n: usize,
         frames: usize,
@@ -743,28 +768,5 @@ impl Engine {
         for v in p.x.iter_mut().chain(p.xp.iter_mut()).chain(p.f.iter_mut()) {
             *v = if v.abs() < FLUSH_BELOW { 0.0 } else { *v };
         }
-    }
-
-    /// Checks every position at the end of a block.
-    fn scan_positions(&mut self) {
-        let limit = self.position_limit;
-        let found = self.points.x.iter().position(|v| !(v.abs() <= limit));
-        if let Some(i) = found {
-            let kind = if self.points.x[i].is_finite() {
-                GuardKind::Runaway
-            } else {
-                GuardKind::NonFinite
-            };
-            self.trip(kind, Some(i as u32), None);
-        }
-    }
-
-    fn trip(&mut self, kind: GuardKind, point: Option<u32>, output: Option<u32>) {
-        self.guard = Some(GuardEvent {
-            sample: self.samples_since_reset,
-            kind,
-            point,
-            output,
-        });
     }
 }

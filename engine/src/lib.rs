@@ -27,6 +27,7 @@ mod display;
 pub mod engine;
 pub mod expr;
 pub mod generators;
+mod guard;
 pub mod info;
 pub mod instrument;
 mod kernels;
@@ -37,6 +38,7 @@ pub mod modes;
 pub mod motion;
 pub(crate) mod network;
 pub mod reference;
+mod rest;
 pub mod spec;
 pub mod stability;
 

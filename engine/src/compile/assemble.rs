@@ -121,6 +121,7 @@ impl<'a> Cx<'a> {
             class_scale: class_scales(rate.mode, rate.sr),
             class_gain: [1.0; NUM_ARG_CLASSES],
             params_dirty: true,
+            rest: Default::default(),
             init_runs: bound.init_runs,
             init_fixed_points: numbering.fixed_points,
             position_limit: DEFAULT_POSITION_LIMIT,

@@ -69,7 +69,9 @@ fn band_order(a: &[u32], b: &[u32], odd: bool) -> (Vec<usize>, Vec<bool>) {
         last = Some((r, d, q));
     }
     close(&mut run, &mut bands);
-    let flip: Vec<bool> = (0..a.len()).map(|i| in_band[i] && odd && a[i] > b[i]).collect();
+    let flip: Vec<bool> = (0..a.len())
+        .map(|i| in_band[i] && odd && a[i] > b[i])
+        .collect();
     let rest = (0..a.len()).filter(|&i| !in_band[i]);
     bands.extend(rest);
     (bands, flip)
@@ -137,7 +139,11 @@ mod tests {
         let (order, _) = band_order(&a, &b, false);
         let mut sorted = order.clone();
         sorted.sort_unstable();
-        assert_eq!(sorted, (0..pairs.len()).collect::<Vec<_>>(), "a permutation");
+        assert_eq!(
+            sorted,
+            (0..pairs.len()).collect::<Vec<_>>(),
+            "a permutation"
+        );
         let (sa, sb): (Vec<u32>, Vec<u32>) = order.iter().map(|&i| (a[i], b[i])).unzip();
         // Rows: 3 bands of 5 links; columns: one band of 12 links (d = 6).
         assert_eq!(banded(&sa, &sb), pairs.len());

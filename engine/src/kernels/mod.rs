@@ -169,13 +169,16 @@ mod tests {
             (out, order)
         };
         let (written, order) = run(&links);
-        let as_written: Vec<(u32, u32)> = links.iter().map(|&(a, b)| (a as u32, b as u32)).collect();
+        let as_written: Vec<(u32, u32)> =
+            links.iter().map(|&(a, b)| (a as u32, b as u32)).collect();
         assert_eq!(order, as_written);
         // The same links shuffled (a fixed linear congruential sequence), some reversed.
         let mut shuffled = links.clone();
         let mut state = 12345u64;
         for i in (1..shuffled.len()).rev() {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             shuffled.swap(i, (state >> 33) as usize % (i + 1));
             if state & 1 == 1 {
                 shuffled[i] = (shuffled[i].1, shuffled[i].0);
