@@ -562,8 +562,18 @@ fn bench(a: &BenchArgs) -> Result<(), Failure> {
     let t = Instant::now();
     let mut done = 0u64;
     let mut blocks = 0u64;
+    // Struck again from rest every second, so that a damped model never reaches its fixed
+    // point, where the engine would hold it instead of stepping (engine/src/rest.rs).
+    let restrike = ((a.sample_rate / block as f64).round() as u64).max(1);
     while done < total {
-        let input = if blocks == 0 { &first } else { &rest };
+        let input = if blocks % restrike == 0 {
+            if blocks > 0 {
+                engine.reset();
+            }
+            &first
+        } else {
+            &rest
+        };
         engine.process(block, input, &mut out);
         done += block as u64;
         blocks += 1;

@@ -20,10 +20,10 @@
 use crate::control::{Changed, ControlArgs};
 pub use crate::display::{IoKind, IoPoint};
 use crate::expr::{ExprRef, Program};
+pub use crate::guard::{GuardEvent, GuardKind};
 use crate::info::ModelInfo;
 pub(crate) use crate::kernels::masses::{single_law, SingleMasses};
 use crate::motion::MotionStore;
-pub use crate::guard::{GuardEvent, GuardKind};
 pub(crate) use crate::rest::Rest;
 use crate::spec::ScaleClass;
 use std::sync::Arc;

@@ -104,7 +104,9 @@ mod tests {
             let (mut held_blocks, mut trips) = (0, 0);
             let mut lcg = 7u64;
             for block in 0..900 {
-                lcg = lcg.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                lcg = lcg
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 let frames = 1 + (lcg >> 33) as usize % 700;
                 let mut input = vec![0.0; ins * frames];
                 match block {

@@ -66,7 +66,9 @@ mod tests {
     fn a_voices_change_is_applied_without_the_main_thread() {
         let store = Arc::new(ModelStore::default());
         store.set_voices(1);
-        let prepared = store.activate(48_000.0).expect("the default model compiles");
+        let prepared = store
+            .activate(48_000.0)
+            .expect("the default model compiles");
         assert_eq!(prepared.voices(), 1);
         let generation = store.generation();
         let watch = VoicesWatch::start(store.clone()).expect("a thread");
