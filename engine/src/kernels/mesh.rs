@@ -112,58 +112,68 @@ pub(crate) fn mesh_step_rows(
     let (len, w) = (mac.length, mac.width);
     let x_edge = x[0];
     let mut pin = 0;
-    // One sweep, row by row, while the rows are in cache: the node law on row r, its pinned
-    // nodes, its velocities (a ring of two rows), its links along the width (which assign its
-    // forces), then the links between rows r − 1 and r. Row r − 1 thereby receives −s after
-    // +s from above, and row r +s after its own row's links: the order of the script (and
-    // of the pass-by-pass kernel this replaces), so the sums are bit-identical.
+    // One sweep, row by row, while the rows are in cache: the node law on row r with its
+    // velocities (a ring of two rows), its pinned nodes, its links along the width, then its
+    // forces: row r's own links' (−s_j after +s_{j−1}, as the pass-by-pass kernel assigns
+    // them) plus the link from row r − 1, whose node receives −s after +s from above. Each
+    // force is the same sum in the same order as in the script, so the result is bit-identical
+    // to `mesh_step_passes`; fusing the velocity into the node law (x' − x is the x − x̃ taken
+    // after it) and the two force passes into one saves two passes over the row.
     for row in 0..len {
         let r = row * w;
-        {
-            let (xr, xpr, fr) = (&mut x[r..r + w], &mut xp[r..r + w], &f[r..r + w]);
-            for j in 0..w {
-                let next = a * xr[j] + b * xpr[j] + fr[j] * inv_m;
-                xpr[j] = xr[j];
-                xr[j] = next;
-            }
-        }
-        while let Some(&p) = mac.pinned.get(pin).filter(|&&p| (p as usize) < r + w) {
-            x[p as usize] = x_edge;
-            xp[p as usize] = x_edge;
-            pin += 1;
-        }
         let (v_even, v_odd) = v[..2 * w].split_at_mut(w);
         let (vc, vp) = if row % 2 == 0 {
             (v_even, &*v_odd)
         } else {
             (v_odd, &*v_even)
         };
-        let (xr, xpr) = (&x[r..r + w], &xp[r..r + w]);
-        for j in 0..w {
-            vc[j] = xr[j] - xpr[j];
-        }
-        let fr = &mut f[r..r + w];
-        if w >= 2 {
-            let sr = &mut s[..w - 1];
-            for j in 0..w - 1 {
-                sr[j] = laws::spring_damper(xr[j] - xr[j + 1], vc[j] - vc[j + 1], k, z);
+        {
+            let (xr, xpr, fr) = (&mut x[r..r + w], &mut xp[r..r + w], &f[r..r + w]);
+            let nodes = xr.iter_mut().zip(xpr.iter_mut());
+            for ((xj, xpj), (fj, vj)) in nodes.zip(fr.iter().zip(vc.iter_mut())) {
+                let old = *xj;
+                let next = a * old + b * *xpj + fj * inv_m;
+                *xpj = old;
+                *xj = next;
+                *vj = next - old;
             }
+        }
+        while let Some(&p) = mac.pinned.get(pin).filter(|&&p| (p as usize) < r + w) {
+            x[p as usize] = x_edge;
+            xp[p as usize] = x_edge;
+            vc[p as usize - r] = x_edge - x_edge;
+            pin += 1;
+        }
+        let xr = &x[r..r + w];
+        let sr = &mut s[..w - 1];
+        for j in 0..w - 1 {
+            sr[j] = laws::spring_damper(xr[j] - xr[j + 1], vc[j] - vc[j + 1], k, z);
+        }
+        let sr = &*sr;
+        // Row r's own forces, as `mesh_step_passes` assigns them before the links from the row
+        // above add to them (macros have both sizes ≥ 2): −s_0, s_{j−1} − s_j, s_{W−2}.
+        if row == 0 {
+            let fr = &mut f[..w];
             fr[0] = -sr[0];
             for j in 1..w - 1 {
                 fr[j] = sr[j - 1] - sr[j];
             }
             fr[w - 1] = sr[w - 2];
         } else {
-            fr.fill(0.0);
-        }
-        if row > 0 {
             let (above, here) = f[r - w..r + w].split_at_mut(w);
-            let (xu, xr) = x[r - w..r + w].split_at(w);
-            for j in 0..w {
-                let sv = laws::spring_damper(xu[j] - xr[j], vp[j] - vc[j], k, z);
+            let xu = &x[r - w..r];
+            let link = |j: usize| laws::spring_damper(xu[j] - xr[j], vp[j] - vc[j], k, z);
+            let sv = link(0);
+            above[0] -= sv;
+            here[0] = -sr[0] + sv;
+            for j in 1..w - 1 {
+                let sv = link(j);
                 above[j] -= sv;
-                here[j] += sv;
+                here[j] = (sr[j - 1] - sr[j]) + sv;
             }
+            let sv = link(w - 1);
+            above[w - 1] -= sv;
+            here[w - 1] = sr[w - 2] + sv;
         }
     }
 }
@@ -174,10 +184,16 @@ mod tests {
     use crate::engine::MacroSlots;
 
     /// Both schedules, from the same irregular state, agree bit for bit for 50 samples, on a
-    /// free mesh, a corner-pinned one and a closed one.
+    /// free mesh, a corner-pinned one and a closed one, of several shapes (macros have both
+    /// sizes ≥ 2).
     #[test]
     fn rows_and_passes_are_bit_identical() {
-        let (len, w) = (7, 5);
+        for (len, w) in [(7, 5), (2, 2), (5, 3), (3, 9), (9, 2)] {
+            mesh_schedules_agree(len, w);
+        }
+    }
+
+    fn mesh_schedules_agree(len: usize, w: usize) {
         let n = len * w;
         let closed: Vec<u32> = (0..n as u32)
             .filter(|&i| {
@@ -185,7 +201,12 @@ mod tests {
                 r == 0 || r == len - 1 || c == 0 || c == w - 1
             })
             .collect();
-        for pinned in [vec![], vec![0, 4, 30, 34], closed] {
+        let corners = {
+            let mut c = vec![0, (w - 1) as u32, (n - w) as u32, (n - 1) as u32];
+            c.dedup();
+            c
+        };
+        for pinned in [vec![], corners, closed] {
             let mac = MeshMacro {
                 base: 0,
                 length: len,
