@@ -118,7 +118,12 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
     let mut lines = Vec::new();
     for (line, s) in split_lines(text) {
         let start = buffer.len();
-        buffer.extend(s.chars());
+        if s.is_ascii() {
+            // Most scripts: one char per byte, an exact-size copy.
+            buffer.extend(s.bytes().map(char::from));
+        } else {
+            buffer.extend(s.chars());
+        }
         lines.push((line, start..buffer.len()));
     }
     let mut items = lines::read_items(&buffer, lines, &mut diags);
