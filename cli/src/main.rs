@@ -566,7 +566,7 @@ fn bench(a: &BenchArgs) -> Result<(), Failure> {
     // point, where the engine would hold it instead of stepping (engine/src/rest.rs).
     let restrike = ((a.sample_rate / block as f64).round() as u64).max(1);
     while done < total {
-        let input = if blocks % restrike == 0 {
+        let input = if blocks.is_multiple_of(restrike) {
             if blocks > 0 {
                 engine.reset();
             }

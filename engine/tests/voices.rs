@@ -500,3 +500,66 @@ fn the_editors_strike_plays_a_voice() {
     assert_eq!(struck.sounding[0], 1);
     assert_eq!(struck.left, played.left);
 }
+
+/// Renders `events` with the Stiffness control swept every block (×0.5 … ×1), so that every
+/// voice is re-tuned every chunk.
+fn render_swept(script: &str, events: &[(u32, Event)], frames: usize) -> Vec<f32> {
+    let mut model = instrument::prepare("test", script, SR).unwrap();
+    model.set_voices(8);
+    let mut controls = quiet();
+    let mut inst = Instrument::new(SR, controls);
+    inst.set_model(Box::new(model));
+    let block = 64;
+    let mut left = vec![0.0f32; frames];
+    let mut right = vec![0.0f32; frames];
+    let mut start = 0;
+    while start < frames {
+        let n = block.min(frames - start);
+        controls.stiffness_octaves = -0.5 + 0.5 * (start as f64 * 20.0 / SR).cos();
+        let mut ev = events
+            .iter()
+            .filter(|(t, _)| (*t as usize) >= start && (*t as usize) < start + n)
+            .map(|&(t, e)| Timed::new(t - start as u32, e));
+        let host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+        let mut out: [&mut [f32]; 2] = [&mut left[start..start + n], &mut right[start..start + n]];
+        inst.process(n, &host, false, &mut ev, &controls, &mut out);
+        start += n;
+    }
+    left
+}
+
+/// Voices on one note share the gains worked out for the first of them each chunk, but only
+/// with the same modulation: three voices on note 60, two of them with Stiffness +1 octave,
+/// under a Stiffness sweep, sum to the three played alone.
+#[test]
+fn voices_on_one_note_share_gains_only_with_the_same_modulation() {
+    let stiffer = |v: i32| Event::Modulation {
+        target: ressort_engine::instrument::events::Modulated::Stiffness,
+        octaves: 1.0,
+        voice_id: v,
+    };
+    let voices: [Vec<(u32, Event)>; 3] = [
+        vec![(0, on(60, 0, Some(1)))],
+        vec![(0, on(60, 0, Some(2))), (0, stiffer(2))],
+        vec![(4_000, on(60, 0, Some(3))), (4_000, stiffer(3))],
+    ];
+    let frames = 24_000;
+    let together = render_swept(STRUCK, &voices.concat(), frames);
+    let mut sum = vec![0.0f64; frames];
+    for v in &voices {
+        for (s, x) in sum.iter_mut().zip(render_swept(STRUCK, v, frames)) {
+            *s += x as f64;
+        }
+    }
+    let p = peak(&together) as f64;
+    let err = together
+        .iter()
+        .zip(&sum)
+        .fold(0.0f64, |m, (a, b)| m.max((*a as f64 - b).abs()));
+    println!("peak {p:.4}, largest difference from the sum {err:.3e}");
+    assert!(
+        p > 1e-3 && p < 0.5,
+        "the voices must sound below the knee ({p})"
+    );
+    assert!(err <= 1e-6 * p, "{err} > 1e-6 × {p}");
+}

@@ -5,14 +5,51 @@
 
 use super::*;
 
+/// Gains worked out for the voices tuned in one pass over the bank, by the bits of a voice's
+/// own inputs (note, Release, modulation): voices on the same note share them. Every entry was
+/// computed from the same smoothed controls, so a hit gives the gains the voice would have
+/// computed, bit for bit ([`Smoothed::gains_offset`] is a function of its inputs).
+pub(super) struct SharedGains {
+    entries: [([u64; 4], Gains); SharedGains::SIZE],
+    len: usize,
+    next: usize,
+}
+
+impl SharedGains {
+    const SIZE: usize = 32;
+
+    pub(super) fn new() -> SharedGains {
+        SharedGains {
+            entries: [([0; 4], Gains::default()); SharedGains::SIZE],
+            len: 0,
+            next: 0,
+        }
+    }
+
+    fn get(&self, key: &[u64; 4]) -> Option<Gains> {
+        self.entries[..self.len]
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|&(_, g)| g)
+    }
+
+    fn insert(&mut self, key: [u64; 4], g: Gains) {
+        self.entries[self.next] = (key, g);
+        self.next = (self.next + 1) % SharedGains::SIZE;
+        self.len = (self.len + 1).min(SharedGains::SIZE);
+    }
+}
+
 /// Puts a voice's gains on its engine: its note, MPE bend and tuning, its polyphonic
 /// modulation, and the Release damper (`release`, a Damping factor) once its key is up.
+/// `shared` holds the gains of voices tuned before it with the same smoothed controls.
 pub(super) fn tune_voice(
     smoothed: &Smoothed,
     view: &ClampView<'_>,
     bank: &mut voices::VoiceBank,
     i: usize,
     release: f64,
+    shared: &mut SharedGains,
 ) -> Gains {
     let v = &mut bank.voices[i];
     let z = if v.state == VoiceState::Released {
@@ -29,7 +66,15 @@ pub(super) fn tune_voice(
             return g;
         }
     }
-    let g = smoothed.gains_offset(view, note_st, z, v.mod_k, v.mod_z, &mut v.tuning);
+    let own = [note_st, z, v.mod_k, v.mod_z].map(f64::to_bits);
+    let g = match shared.get(&own) {
+        Some(g) => g,
+        None => {
+            let g = smoothed.gains_offset(view, note_st, z, v.mod_k, v.mod_z, &mut v.tuning);
+            shared.insert(own, g);
+            g
+        }
+    };
     v.tuned = Some((key, g));
     smoothed.set(&mut bank.copy(i), view.macros, &g);
     g
@@ -62,7 +107,14 @@ impl Instrument {
         };
         let view = clamp_view!(m);
         let release = 16f64.powf(self.controls.release);
-        self.gains = tune_voice(&self.smoothed, &view, bank, i, release);
+        self.gains = tune_voice(
+            &self.smoothed,
+            &view,
+            bank,
+            i,
+            release,
+            &mut SharedGains::new(),
+        );
     }
 
     /// An expression event: MPE bend, pressure, note tuning, polyphonic modulation. Returns

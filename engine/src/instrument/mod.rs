@@ -78,7 +78,7 @@ macro_rules! clamp_view {
 
 /// Per-voice expression and controllers (see the module).
 mod expression;
-use expression::tune_voice;
+use expression::{tune_voice, SharedGains};
 
 /// The sustain pedal's controller: it holds released voices.
 pub const SUSTAIN_CC: u8 = 64;
@@ -324,11 +324,12 @@ impl Instrument {
         let mut shown = self.smoothed.gains(&view, 0.0, 1.0);
         self.smoothed.set(&mut m.engine, view.macros, &shown);
         let mut newest = 0;
+        let mut shared = SharedGains::new();
         for i in 0..bank.voices.len() {
             if bank.voices[i].state == VoiceState::Free {
                 continue;
             }
-            let g = tune_voice(&self.smoothed, &view, bank, i, release);
+            let g = tune_voice(&self.smoothed, &view, bank, i, release, &mut shared);
             if bank.voices[i].started > newest {
                 newest = bank.voices[i].started;
                 shown = g;

@@ -141,7 +141,8 @@ pub(crate) fn mesh_step_rows(
         while let Some(&p) = mac.pinned.get(pin).filter(|&&p| (p as usize) < r + w) {
             x[p as usize] = x_edge;
             xp[p as usize] = x_edge;
-            vc[p as usize - r] = x_edge - x_edge;
+            // The velocity as `mesh_step_passes` takes it, after the pin.
+            vc[p as usize - r] = x[p as usize] - xp[p as usize];
             pin += 1;
         }
         let xr = &x[r..r + w];
