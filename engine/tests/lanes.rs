@@ -90,6 +90,16 @@ fn lanes_equal_plain(
             lanes.set_class_gain(l, class, base * g);
             plain[l].set_class_gain(class, base * g);
         }
+        // Halfway, a parameter named `at` (a connection point's coordinate) moves in every
+        // copy: the lanes re-place their connection points.
+        if block == 200 {
+            if let Some(id) = template.param_id("at") {
+                lanes.set_param(id, 0.71).unwrap();
+                for p in &mut plain {
+                    p.set_param(id, 0.71).unwrap();
+                }
+            }
+        }
         lane_in.fill(0.0);
         for c in 0..n_in {
             for l in 0..LANES {
@@ -166,6 +176,35 @@ fn element_mesh() -> String {
     text + "@p springDamper @g @n0 0.1 0.001\n@in1 frcInput @n7\n@out1 posOutput @n22\n"
 }
 
+/// Macros of every kind with connection points (inputs, outputs and interactions on them,
+/// one placed by a parameter), a hammer striking one through a contact, and an avatar plucking
+/// another.
+const STRUCTURES: &str = "\
+@at param 0.6
+@s string 24 1. 0.1 0.0005 0.0001 0. 0.
+@t stiffString 16 1. 0.12 0.03 0.0004 0. 0.
+@c chain 6 1. 0.2 0.001 0. 0.
+@m mesh 5 4 1. 0.1 0.001 0.00005 0. 0.
+@k cornerMesh 4 6 1.3 0.09 0.002 0. 0.
+@q closedMesh 6 5 0.8 0.11 0.001 0.0002 0. 0.
+@h mass 1. 0.2 0.
+@g ground 0.
+@hit contact @h [@s 0.3] 0.05 0.002 0.
+@hang springDamper @g @h 0.001 0.01
+@j springDamper [@s 0.8] [@t 0.4] 0.02 0.001
+@u springDamper [@t 0.9] [@m 0.3 0.6] 0.03 0.001
+@w springDamper [@m 0.8 0.2] [@k 0.5 0.5] 0.02 0.0005
+@y springDamper [@k 0.2 0.9] [@q 0.4 0.7] 0.02 0.0005
+@e springDamper [@c 0.] [@q 0.6 0.5] 0.01 0.001
+@pl nlPluck [@c 0.5] @in2 0.05 0.001 0.001
+@in1 frcInput @h
+@in2 posInput 0.
+@in3 frcInput [@q 0.3 0.3]
+@out1 posOutput [@s at]
+@out2 posOutput [@q 0.5 0.4]
+@out3 frcOutput [@k 0.5 0.5]
+";
+
 #[test]
 fn each_lane_is_a_plain_engine_bit_for_bit() {
     let k = [1.0, 0.5, 1.7, 2.3];
@@ -189,6 +228,17 @@ fn each_lane_is_a_plain_engine_bit_for_bit() {
         })
         .collect();
     lanes_equal_plain(&spec(&reversed), 48_000.0, k, z, strike);
+    lanes_equal_plain(&spec(STRUCTURES), 48_000.0, k, z, strike);
+    for name in [
+        "mesh-15x15.mdl",
+        "plucked-oscillator.mdl",
+        "bowed-oscillator.mdl",
+        "fretted-string.mdl",
+        "hammer-oscillator.mdl",
+        "gravity-oscillator.mdl",
+    ] {
+        lanes_equal_plain(&preset(name), 48_000.0, k, z, strike);
+    }
     lanes_equal_plain(&preset("drunk-triangles.mdl"), 48_000.0, k, z, strike);
     lanes_equal_plain(
         &preset("drunk-triangles.mdl"),

@@ -115,12 +115,24 @@ fn main() {
         }
     }
     // The instrument with a voice bank through a storm of 10,000 notes (stealing, releasing,
-    // the sustain pedal, controllers, pitch bend), host input, and a reset.
-    {
+    // the sustain pedal, controllers, pitch bend), host input, and a reset: a small model of
+    // single masses, and macros with connection points (both in voice lanes).
+    let storms = [
+        (
+            "instrument_note_storm",
+            "@K param 0.05\n@o osc 1. K 0.0005 0. 0.\n@g ground 0.1\n@h mass 1. 0.1 0.\n\
+             @hs springDamper @g @h 0.0001 0.01\n@hit contact @o @h 0.1 0.001\n\
+             @in1 frcInput @h\n@out1 posOutput @o\n",
+        ),
+        (
+            "instrument_note_storm_macros",
+            "@s string 24 1. 0.1 0.0005 0. 0.\n@m cornerMesh 5 4 1. 0.1 0.001 0. 0.\n\
+             @j springDamper [@s 0.5] [@m 0.5 0.5] 0.02 0.001\n@in1 frcInput [@s 0.3]\n\
+             @out1 posOutput [@m 0.7 0.6]\n",
+        ),
+    ];
+    for (name, script) in storms {
         use ressort_engine::instrument::{self, Controls, Event, Instrument, Timed};
-        let script = "@K param 0.05\n@o osc 1. K 0.0005 0. 0.\n@g ground 0.1\n@h mass 1. 0.1 0.\n\
-                      @hs springDamper @g @h 0.0001 0.01\n@hit contact @o @h 0.1 0.001\n\
-                      @in1 frcInput @h\n@out1 posOutput @o\n";
         let mut model = instrument::prepare("storm", script, 48_000.0).unwrap();
         model.set_voices(16);
         let controls = Controls {
@@ -168,14 +180,12 @@ fn main() {
         });
         if allocations == 0 && notes >= 10_000 && ended > 0 {
             passed += 1;
-            println!(
-                "test no_alloc::instrument_note_storm ... ok ({notes} notes, {ended} voices ended)"
-            );
+            println!("test no_alloc::{name} ... ok ({notes} notes, {ended} voices ended)");
         } else {
             failed += 1;
             println!(
-                "test no_alloc::instrument_note_storm ... FAILED ({allocations} allocations, \
-                 {ended} voices ended)"
+                "test no_alloc::{name} ... FAILED ({allocations} allocations, {ended} voices \
+                 ended)"
             );
         }
     }

@@ -86,16 +86,23 @@ fn peak(x: &[f32]) -> f32 {
     x.iter().fold(0.0f32, |m, v| m.max(v.abs()))
 }
 
-/// A string macro struck directly: macros do not run in voice lanes, so its voices are
-/// whole engines.
+/// A string macro struck directly through connection points: its voices run in lanes.
 const STRING: &str = "\
 @s string 24 1. 0.1 0.0005 0. 0.
 @in1 frcInput [@s 0.3]
 @out1 posOutput [@s 0.7]
 ";
 
+/// A string macro of 400 nodes: one voice fills the vectors, so its voices are whole engines
+/// (`MAX_LANE_POINTS`).
+const LONG_STRING: &str = "\
+@s string 400 1. 0.1 0.0005 0. 0.
+@in1 frcInput [@s 0.3]
+@out1 posOutput [@s 0.7]
+";
+
 #[test]
-fn small_models_run_in_voice_lanes_and_macro_models_on_engines() {
+fn small_models_run_in_voice_lanes_and_large_ones_on_engines() {
     use ressort_engine::instrument::voices::Copies;
     let bank_of = |script: &str| {
         let mut m = instrument::prepare("test", script, SR).unwrap();
@@ -104,13 +111,15 @@ fn small_models_run_in_voice_lanes_and_macro_models_on_engines() {
     };
     assert!(matches!(bank_of(STRUCK), Copies::Lanes(_)));
     assert!(matches!(bank_of(DAMPED), Copies::Lanes(_)));
-    assert!(matches!(bank_of(STRING), Copies::Engines(_)));
+    assert!(matches!(bank_of(STRING), Copies::Lanes(_)));
+    assert!(matches!(bank_of(LONG_STRING), Copies::Engines(_)));
 }
 
 #[test]
 fn a_chord_is_the_sum_of_its_notes() {
     chord_is_the_sum_of_its_notes(STRUCK);
     chord_is_the_sum_of_its_notes(STRING);
+    chord_is_the_sum_of_its_notes(LONG_STRING);
 }
 
 fn chord_is_the_sum_of_its_notes(script: &str) {
@@ -148,7 +157,7 @@ fn chord_is_the_sum_of_its_notes(script: &str) {
 fn a_bank_of_one_note_plays_the_monophonic_engine() {
     // One note from rest: a voice of the bank is the engine itself, to the bit.
     let note = [(100u32, Event::note_on(60, 0.8))];
-    for script in [STRUCK, STRING] {
+    for script in [STRUCK, STRING, LONG_STRING] {
         let mono = render(script, 1, quiet(), &note, 24_000).left;
         let poly = render(script, 4, quiet(), &note, 24_000).left;
         assert!(peak(&mono) > 1e-3);

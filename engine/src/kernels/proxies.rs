@@ -23,6 +23,11 @@ impl Proxies {
 
     /// Recomputes the nodes and weights of proxy `i` from its coordinates (spec §2.8).
     pub fn derive(&mut self, i: usize, args: &[f64]) {
+        self.derive_with(i, |slot| args[slot]);
+    }
+
+    /// [`Proxies::derive`] with the argument of each slot given by `arg`.
+    pub fn derive_with(&mut self, i: usize, arg: impl Fn(usize) -> f64) {
         /// Clamped position along `n` nodes: (lower node, upper node, fraction).
         fn along(c: f64, n: u32) -> (u32, u32, f64) {
             let last = n.saturating_sub(1);
@@ -36,12 +41,12 @@ impl Proxies {
         let (base, length, width) = self.geometry[i];
         let [s0, s1] = self.coord_slots[i];
         if width == 0 {
-            let (m1, m2, a) = along(args[s0], length);
+            let (m1, m2, a) = along(arg(s0), length);
             self.nodes[i] = [base + m1, base + m2, base + m1, base + m1];
             self.weights[i] = [1.0 - a, a, 0.0, 0.0];
         } else {
-            let (i1, i2, ai) = along(args[s0], length);
-            let (j1, j2, aj) = along(args[s1], width);
+            let (i1, i2, ai) = along(arg(s0), length);
+            let (j1, j2, aj) = along(arg(s1), width);
             let node = |i: u32, j: u32| base + i * width + j;
             self.nodes[i] = [node(i1, j1), node(i2, j1), node(i1, j2), node(i2, j2)];
             self.weights[i] = [
