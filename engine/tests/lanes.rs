@@ -236,6 +236,7 @@ fn each_lane_is_a_plain_engine_bit_for_bit() {
         "fretted-string.mdl",
         "hammer-oscillator.mdl",
         "gravity-oscillator.mdl",
+        "struck-string.mdl",
     ] {
         lanes_equal_plain(&preset(name), 48_000.0, k, z, strike);
     }

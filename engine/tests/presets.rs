@@ -66,6 +66,8 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("resonant-strings.mdl", Some((804, 968))),
     ("rolling-mesh.mdl", Some((101, 181))),
     ("two-fingers-string.mdl", Some((127, 258))),
+    // Ressort's own: the counts its header gives.
+    ("struck-string.mdl", Some((20, 19))),
     // §7.6 Oscillator tutorial series: no counts given.
     ("harmonic-oscillator.mdl", None),
     ("hammer-oscillator.mdl", None),

@@ -27,6 +27,7 @@ pub const PRESETS: &[Preset] = presets![
     "fretted-string",
     "bowed-string",
     "plucked-harmonics",
+    "struck-string",
     "harmonic-oscillator",
     "hammer-oscillator",
     "gravity-oscillator",
