@@ -183,8 +183,9 @@ pub struct Engine {
     /// Whether the state is known to be a fixed point of the sample loop ([`Rest`]).
     pub(crate) rest: Rest,
     /// The instruction set the sample loop runs with, detected once: the loop is compiled for
-    /// the baseline and for AVX2 (pulp's x86-v3), and [`Engine::process`] picks one per block.
-    /// Without FMA contraction both give the same IEEE operations, so the same samples.
+    /// the baseline, AVX2 and AVX-512 (pulp's x86-v3 and x86-v4), and [`Engine::process`]
+    /// picks the best the CPU has. Without FMA contraction all give the same IEEE operations,
+    /// so the same samples.
     pub(crate) arch: pulp::Arch,
 }
 

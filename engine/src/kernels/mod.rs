@@ -433,10 +433,22 @@ mod tests {
         merged
     }
 
-    /// The sample loop gives the same bits whichever instruction set runs it (the baseline or
-    /// AVX2 through pulp): every preset, 4096 samples after a strike on every input.
+    /// The sample loop gives the same bits whichever instruction set runs it (the baseline,
+    /// AVX2 or AVX-512 through pulp, each this CPU has): every preset, 4096 samples after a
+    /// strike on every input.
     #[test]
     fn every_instruction_set_gives_the_same_samples() {
+        #[allow(unused_mut)]
+        let mut archs = Vec::new();
+        #[cfg(target_arch = "x86_64")]
+        {
+            if let Some(v3) = pulp::x86::V3::try_new() {
+                archs.push(("AVX2", pulp::Arch::V3(v3)));
+            }
+            if let Some(v4) = pulp::x86::V4::try_new() {
+                archs.push(("AVX-512", pulp::Arch::V4(v4)));
+            }
+        }
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
         let mut names: Vec<_> = std::fs::read_dir(&dir)
             .unwrap()
@@ -448,11 +460,10 @@ mod tests {
         for path in names {
             let text = std::fs::read_to_string(&path).unwrap();
             let spec = parse(&text).spec.expect("a preset parses");
-            let mut fast = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
-            let mut plain = fast.clone();
+            let mut plain = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
             plain.arch = pulp::Arch::Scalar;
-            let (n_in, n_out) = (fast.info().num_inputs(), fast.info().num_outputs());
-            let frames = if fast.info().num_points > 5000 {
+            let (n_in, n_out) = (plain.info().num_inputs(), plain.info().num_outputs());
+            let frames = if plain.info().num_points > 5000 {
                 256
             } else {
                 4096
@@ -461,18 +472,19 @@ mod tests {
             for c in 0..n_in {
                 inputs[c * frames] = -0.01;
             }
-            let mut a = vec![0.0; n_out * frames];
-            let mut b = vec![0.0; n_out * frames];
-            fast.process(frames, &inputs, &mut a);
-            plain.process(frames, &inputs, &mut b);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(&a), bits(&b), "{}", path.display());
-            assert_eq!(
-                bits(fast.positions()),
-                bits(plain.positions()),
-                "{}",
-                path.display()
-            );
+            let mut want = vec![0.0; n_out * frames];
+            let start = plain.clone();
+            plain.process(frames, &inputs, &mut want);
+            for &(name, arch) in &archs {
+                let mut fast = start.clone();
+                fast.arch = arch;
+                let mut got = vec![0.0; n_out * frames];
+                fast.process(frames, &inputs, &mut got);
+                let at = format!("{} with {name}", path.display());
+                assert_eq!(bits(&got), bits(&want), "{at}");
+                assert_eq!(bits(fast.positions()), bits(plain.positions()), "{at}");
+            }
         }
     }
 }
