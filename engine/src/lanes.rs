@@ -642,11 +642,7 @@ fn apply(
 /// slower (1000 Drunk Triangles voices, 17.1 against 17.9 µs per sample). The same IEEE
 /// operations either way, so the same samples.
 fn lane_arch() -> pulp::Arch {
-    #[cfg(target_arch = "x86_64")]
-    if let Some(v3) = pulp::x86::V3::try_new() {
-        return pulp::Arch::V3(v3);
-    }
-    pulp::Arch::new()
+    crate::kernels::avx2().unwrap_or_default()
 }
 
 /// One block of [`LaneEngine::process`] as a pulp operation (see `Engine::process`).

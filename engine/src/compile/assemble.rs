@@ -130,8 +130,9 @@ impl<'a> Cx<'a> {
             motion: None,
             motion_interval: options.motion_interval.max(1),
             motion_counter: 0,
-            arch: pulp::Arch::new(),
+            arch: Default::default(),
         };
+        engine.arch = crate::kernels::arch_for(&engine.macros);
         engine.reset();
         Ok(engine)
     }
