@@ -670,11 +670,7 @@ impl Engine {
                 store.write(&self.points.x[..self.info.num_points]);
             }
         }
-        if let Some(bad) = self.write_outputs(n, io.frames, io.out_channels, outputs) {
-            self.trip(bad.0, None, Some(bad.1));
-            for ch in 0..io.out_channels {
-                outputs[ch * io.frames + n..(ch + 1) * io.frames].fill(0.0);
-            }
+        if self.outputs_or_trip(n, io.frames, io.out_channels, outputs) {
             return true;
         }
         self.samples_since_reset += 1;
@@ -724,10 +720,30 @@ impl Engine {
         self.proxies.spread_forces(&mut self.points);
     }
 
+    /// Stage 6 and its guard: writes frame `n` of every output; on a bad value, trips and
+    /// clears the block's outputs from `n` on. Returns whether it tripped.
+    #[inline(always)]
+    pub(crate) fn outputs_or_trip(
+        &mut self,
+        n: usize,
+        frames: usize,
+        out_channels: usize,
+        outputs: &mut [f64],
+    ) -> bool {
+        let Some(bad) = self.write_outputs(n, frames, out_channels, outputs) else {
+            return false;
+        };
+        self.trip(bad.0, None, Some(bad.1));
+        for ch in 0..out_channels {
+            outputs[ch * frames + n..(ch + 1) * frames].fill(0.0);
+        }
+        true
+    }
+
     /// Stage 6: writes frame `n` of every output. Returns the first bad value's kind and
     /// channel, if any.
     #[inline(always)]
-    pub(crate) fn write_outputs(
+    fn write_outputs(
         &self,
         n: usize,
         frames: usize,

@@ -42,12 +42,8 @@ impl Engine {
         out_channels: usize,
     ) -> usize {
         for n in start..frames {
-            if let Some(bad) = self.write_outputs(n, frames, out_channels, outputs) {
-                // Only a lowered position limit can make a held output bad.
-                self.trip(bad.0, None, Some(bad.1));
-                for ch in 0..out_channels {
-                    outputs[ch * frames + n..(ch + 1) * frames].fill(0.0);
-                }
+            // Only a lowered position limit can make a held output bad.
+            if self.outputs_or_trip(n, frames, out_channels, outputs) {
                 return n + 1;
             }
             self.samples_since_reset += 1;

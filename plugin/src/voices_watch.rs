@@ -33,9 +33,8 @@ impl VoicesWatch {
             .name("ressort-voices".into())
             .spawn(move || {
                 while !flag.load(Ordering::Acquire) {
-                    if store.voices_stale() {
-                        store.apply_voices();
-                    }
+                    // A no-op unless the setting is stale.
+                    store.apply_voices();
                     std::thread::park_timeout(INTERVAL);
                 }
             })

@@ -91,6 +91,7 @@ impl<'a> Cx<'a> {
             bound.singles.len(),
             proxies.coord_slots.iter().flatten().copied(),
         );
+        let arch = crate::kernels::arch_for(&bound.macros);
         let mut engine = Engine {
             info,
             points: Points {
@@ -130,9 +131,8 @@ impl<'a> Cx<'a> {
             motion: None,
             motion_interval: options.motion_interval.max(1),
             motion_counter: 0,
-            arch: Default::default(),
+            arch,
         };
-        engine.arch = crate::kernels::arch_for(&engine.macros);
         engine.reset();
         Ok(engine)
     }

@@ -8,7 +8,9 @@ use super::*;
 /// Gains worked out for the voices tuned in one pass over the bank, by the bits of a voice's
 /// own inputs (note, Release, modulation): voices on the same note share them. Every entry was
 /// computed from the same smoothed controls, so a hit gives the gains the voice would have
-/// computed, bit for bit ([`Smoothed::gains_offset`] is a function of its inputs).
+/// computed, bit for bit ([`Smoothed::gains_offset`] is a function of its inputs). Cleared
+/// before each pass; kept in the instrument so that a pass writes no table on the stack.
+#[derive(Debug)]
 pub(super) struct SharedGains {
     entries: [([u64; 4], Gains); SharedGains::SIZE],
     len: usize,
@@ -24,6 +26,12 @@ impl SharedGains {
             len: 0,
             next: 0,
         }
+    }
+
+    /// Empties the table for a pass with other smoothed controls.
+    pub(super) fn clear(&mut self) {
+        self.len = 0;
+        self.next = 0;
     }
 
     fn get(&self, key: &[u64; 4]) -> Option<Gains> {
@@ -107,13 +115,14 @@ impl Instrument {
         };
         let view = clamp_view!(m);
         let release = 16f64.powf(self.controls.release);
+        self.shared_gains.clear();
         self.gains = tune_voice(
             &self.smoothed,
             &view,
             bank,
             i,
             release,
-            &mut SharedGains::new(),
+            &mut self.shared_gains,
         );
     }
 

@@ -115,6 +115,8 @@ pub struct Instrument {
     controls: Controls,
     smoothed: Smoothed,
     gains: Gains,
+    /// The gains of one tuning pass over the bank, by voice inputs (`expression::tune_voice`).
+    shared_gains: SharedGains,
     /// Output gain where the current chunk's per-sample ramp starts.
     last_output_gain: f64,
     /// Length of the current chunk and the samples of it already rendered. A chunk runs to
@@ -167,6 +169,7 @@ impl Instrument {
             last_output_gain: smoothed.output_gain.value,
             smoothed,
             gains: Gains::default(),
+            shared_gains: SharedGains::new(),
             chunk_len: 0,
             chunk_done: 0,
             counter: 0,
@@ -324,12 +327,19 @@ impl Instrument {
         let mut shown = self.smoothed.gains(&view, 0.0, 1.0);
         self.smoothed.set(&mut m.engine, view.macros, &shown);
         let mut newest = 0;
-        let mut shared = SharedGains::new();
+        self.shared_gains.clear();
         for i in 0..bank.voices.len() {
             if bank.voices[i].state == VoiceState::Free {
                 continue;
             }
-            let g = tune_voice(&self.smoothed, &view, bank, i, release, &mut shared);
+            let g = tune_voice(
+                &self.smoothed,
+                &view,
+                bank,
+                i,
+                release,
+                &mut self.shared_gains,
+            );
             if bank.voices[i].started > newest {
                 newest = bank.voices[i].started;
                 shown = g;

@@ -470,15 +470,10 @@ mod tests {
     #[test]
     fn every_instruction_set_gives_the_same_samples() {
         #[allow(unused_mut)]
-        let mut archs = Vec::new();
+        let mut archs: Vec<_> = super::avx2().map(|a| ("AVX2", a)).into_iter().collect();
         #[cfg(target_arch = "x86_64")]
-        {
-            if let Some(v3) = pulp::x86::V3::try_new() {
-                archs.push(("AVX2", pulp::Arch::V3(v3)));
-            }
-            if let Some(v4) = pulp::x86::V4::try_new() {
-                archs.push(("AVX-512", pulp::Arch::V4(v4)));
-            }
+        if let Some(v4) = pulp::x86::V4::try_new() {
+            archs.push(("AVX-512", pulp::Arch::V4(v4)));
         }
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
         let mut names: Vec<_> = std::fs::read_dir(&dir)
