@@ -131,16 +131,31 @@ fn ends_with_exponent_marker(tok: &[char]) -> bool {
     }
 }
 
-/// Tokenises one command or directive line (spec §3.3). A `#` outside a quoted group starts a
-/// comment (spec §3.2). Reports the first lexical error of the line and returns `None` then;
-/// warns about `+` separators between two non-blank characters.
+/// Tokenises one command or directive line (spec §3.3) onto the end of `tokens`, the tokens
+/// of the whole script in one vector, and returns the line's range in it. A `#` outside a
+/// quoted group starts a comment (spec §3.2). Reports the first lexical error of the line and
+/// returns `None` then, with `tokens` as it was; warns about `+` separators between two
+/// non-blank characters.
 pub(crate) fn tokenize<'a>(
     chars: &'a [char],
     line: u32,
     diags: &mut Diags,
-) -> Option<Vec<Token<'a>>> {
-    // A command has a label, a keyword and up to seven arguments: one allocation for most lines.
-    let mut tokens = Vec::with_capacity(8);
+    tokens: &mut Vec<Token<'a>>,
+) -> Option<std::ops::Range<usize>> {
+    let start = tokens.len();
+    let lexed = lex_line(chars, line, diags, tokens);
+    if lexed.is_none() {
+        tokens.truncate(start);
+    }
+    lexed.map(|()| start..tokens.len())
+}
+
+fn lex_line<'a>(
+    chars: &'a [char],
+    line: u32,
+    diags: &mut Diags,
+    tokens: &mut Vec<Token<'a>>,
+) -> Option<()> {
     let mut i = 0;
     while let Some(&c) = chars.get(i) {
         if is_blank(c) {
@@ -257,7 +272,7 @@ pub(crate) fn tokenize<'a>(
             }
         }
     }
-    Some(tokens)
+    Some(())
 }
 
 /// Splits the content of a vector or connection-point bracket into items separated by blanks
@@ -295,11 +310,9 @@ mod tests {
     fn toks(s: &str) -> Vec<String> {
         let chars: Vec<char> = s.chars().collect();
         let mut d = Diags::default();
-        tokenize(&chars, 1, &mut d)
-            .unwrap()
-            .iter()
-            .map(Token::source)
-            .collect()
+        let mut tokens = Vec::new();
+        tokenize(&chars, 1, &mut d, &mut tokens).unwrap();
+        tokens.iter().map(Token::source).collect()
     }
 
     #[test]

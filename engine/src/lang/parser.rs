@@ -16,7 +16,7 @@
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::generate::{self, GenRequest};
-use super::lexer::split_lines;
+use super::lexer::{split_lines, Token};
 use super::symbols::Symbols;
 use super::Parsed;
 use crate::spec::{ModelSpec, SampleRateMode};
@@ -126,13 +126,14 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
         }
         lines.push((line, start..buffer.len()));
     }
-    let mut items = lines::read_items(&buffer, lines, &mut diags);
-    let symbols = labels::declare_labels(&mut items, &mut diags);
+    let (mut items, tokens) = lines::read_items(&buffer, lines, &mut diags);
+    let symbols = labels::declare_labels(&mut items, &tokens, &mut diags);
 
     // Pass 2: directives and commands in script order.
     let mut b = Builder {
         diags,
         symbols: &symbols,
+        tokens: &tokens,
         spec: ModelSpec {
             elements: Vec::with_capacity(items.len()),
             ..ModelSpec::default()
@@ -144,7 +145,7 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
     for item in items.iter().filter(|i| !i.broken) {
         if let Some(req) = &item.generator {
             b.generate(req);
-        } else if is_generate(item) {
+        } else if is_generate(item, &tokens) {
             // Reported in pass 1.
         } else if item.directive {
             b.directive(item);
@@ -172,6 +173,8 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
 struct Builder<'s> {
     diags: Diags,
     symbols: &'s Symbols,
+    /// Every item's tokens (see `Item::tokens`).
+    tokens: &'s [Token<'s>],
     spec: ModelSpec,
     /// Open scopes, in order of opening (indices into `spec.buffers`).
     open: Vec<u32>,

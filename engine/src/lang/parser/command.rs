@@ -22,7 +22,8 @@ struct Tag {
 
 impl Builder<'_> {
     pub(super) fn command(&mut self, item: &Item) {
-        let Some(first) = item.tokens.first() else {
+        let tokens = item.tokens(self.tokens);
+        let Some(first) = tokens.first() else {
             return;
         };
         let label = first.label();
@@ -34,7 +35,7 @@ impl Builder<'_> {
             label: Some(&label),
         };
         let span = Span::new(item.line, first.col);
-        let Some(kw) = item.tokens.get(1) else {
+        let Some(kw) = tokens.get(1) else {
             self.diags.push(
                 at.diag(
                     DiagnosticCode::WrongArgumentCount,
@@ -67,7 +68,7 @@ impl Builder<'_> {
             self.diags.push(d.with_found(kw.source()));
             return;
         };
-        let args = item.tokens.get(2..).unwrap_or(&[]);
+        let args = tokens.get(2..).unwrap_or(&[]);
         let (min, max, signature) = arity(shape);
         let (args, tag) = match shape {
             Shape::Mass | Shape::Osc | Shape::Ground | Shape::MassG => {

@@ -24,11 +24,12 @@ fn plural_args(count: &[usize]) -> String {
 impl Builder<'_> {
     /// `~begin`, `~end`, `~samplerate` (spec §3.10, §3.11).
     pub(super) fn directive(&mut self, item: &Item) {
-        let Some(first) = item.tokens.first() else {
+        let tokens = item.tokens(self.tokens);
+        let Some(first) = tokens.first() else {
             return;
         };
         let name = first.label();
-        let args = item.tokens.get(1..).unwrap_or(&[]);
+        let args = tokens.get(1..).unwrap_or(&[]);
         let at = At {
             line: item.line,
             label: None,

@@ -4,21 +4,21 @@ use super::keywords::{shape_of_chars, sym_kind};
 use super::lines::{is_generate, Item};
 use crate::lang::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use crate::lang::generate::{self, GenRequest, Read, MAX_GENERATED_ELEMENTS};
-use crate::lang::lexer::TokKind;
+use crate::lang::lexer::{TokKind, Token};
 use crate::lang::symbols::{SymKind, Symbol, Symbols};
 
 /// Pass 1: every label (spec §3.4: names and elements may be used before their declaration
 /// line), those a `~generate` directive creates included (§4), with duplicates reported.
 /// A `~generate` directive is read here and kept on its item for pass 2.
-pub(super) fn declare_labels(items: &mut [Item<'_>], diags: &mut Diags) -> Symbols {
+pub(super) fn declare_labels(items: &mut [Item], all: &[Token], diags: &mut Diags) -> Symbols {
     let mut symbols = Symbols::with_capacity(items.len());
     let mut budget = MAX_GENERATED_ELEMENTS;
     for item in items.iter_mut() {
         if item.directive {
             if let Some(name) = item.broken_generator.take() {
                 symbols.insert_broken_generator(name);
-            } else if is_generate(item) {
-                match generate::read(&item.tokens, item.line, diags, &mut budget) {
+            } else if is_generate(item, all) {
+                match generate::read(item.tokens(all), item.line, diags, &mut budget) {
                     Read::Ready(req) => {
                         if declare_generated(&req, &mut symbols, diags) {
                             item.generator = Some(req);
@@ -30,7 +30,8 @@ pub(super) fn declare_labels(items: &mut [Item<'_>], diags: &mut Diags) -> Symbo
             }
             continue;
         }
-        let Some(first) = item.tokens.first() else {
+        let tokens = item.tokens(all);
+        let Some(first) = tokens.first() else {
             continue;
         };
         let label = first.label();
@@ -46,8 +47,7 @@ pub(super) fn declare_labels(items: &mut [Item<'_>], diags: &mut Diags) -> Symbo
             ));
             continue;
         }
-        let kind = item
-            .tokens
+        let kind = tokens
             .get(1)
             .filter(|t| t.kind != TokKind::Bracket)
             .and_then(|t| shape_of_chars(t.text))

@@ -7,13 +7,16 @@ use crate::lang::lexer::{is_blank, tokenize, TokKind, Token};
 
 /// Reads the script's lines (`(line number, range in buffer)`) into items: command and
 /// directive lines tokenised, comments and blank lines skipped, other lines ignored with a
-/// warning when they look like a command.
+/// warning when they look like a command. The tokens of every item are in one vector (one
+/// allocation for the script, not one per line).
 pub(super) fn read_items<'a>(
     buffer: &'a [char],
     lines: Vec<(u32, std::ops::Range<usize>)>,
     diags: &mut Diags,
-) -> Vec<Item<'a>> {
+) -> (Vec<Item>, Vec<Token<'a>>) {
     let mut items = Vec::with_capacity(lines.len());
+    // A command has a label, a keyword and a few arguments.
+    let mut tokens = Vec::with_capacity(lines.len() * 6);
     for (line, range) in lines {
         let chars = buffer.get(range).unwrap_or(&[]);
         let Some(first) = chars.iter().position(|c| !is_blank(*c)) else {
@@ -22,12 +25,12 @@ pub(super) fn read_items<'a>(
         match chars.get(first) {
             Some('@') | Some('~') => {
                 let directive = chars.get(first) == Some(&'~');
-                match tokenize(chars, line, diags) {
-                    Some(tokens) => items.push(Item {
+                match tokenize(chars, line, diags, &mut tokens) {
+                    Some(range) => items.push(Item {
                         line,
                         directive,
                         broken: false,
-                        tokens,
+                        tokens: range,
                         generator: None,
                         broken_generator: None,
                     }),
@@ -42,16 +45,17 @@ pub(super) fn read_items<'a>(
                             })
                             .count();
                         let label = rest.get(..len).unwrap_or(&[]);
+                        tokens.push(Token {
+                            kind: TokKind::Bare,
+                            text: label,
+                            col: col_of(first),
+                            inner_col: col_of(first),
+                        });
                         items.push(Item {
                             line,
                             directive: false,
                             broken: true,
-                            tokens: vec![Token {
-                                kind: TokKind::Bare,
-                                text: label,
-                                col: col_of(first),
-                                inner_col: col_of(first),
-                            }],
+                            tokens: tokens.len() - 1..tokens.len(),
                             generator: None,
                             broken_generator: None,
                         });
@@ -70,7 +74,7 @@ pub(super) fn read_items<'a>(
                                 line,
                                 directive: true,
                                 broken: true,
-                                tokens: Vec::new(),
+                                tokens: 0..0,
                                 generator: None,
                                 broken_generator: Some(name),
                             });
@@ -82,7 +86,7 @@ pub(super) fn read_items<'a>(
             _ => check_ignored_line(chars, line, diags),
         }
     }
-    items
+    (items, tokens)
 }
 
 fn col_of(i: usize) -> u32 {
@@ -137,20 +141,32 @@ fn check_ignored_line(chars: &[char], line: u32, diags: &mut Diags) {
 }
 
 /// A command or directive line, tokenised.
-pub(super) struct Item<'a> {
+pub(super) struct Item {
     pub(super) line: u32,
     pub(super) directive: bool,
     /// A command line with a lexical error: only its label token is kept, for pass 1.
     pub(super) broken: bool,
-    pub(super) tokens: Vec<Token<'a>>,
+    /// The line's tokens in the script's token vector (see [`Item::tokens`]).
+    pub(super) tokens: std::ops::Range<usize>,
     /// A `~generate` directive read in pass 1 and expanded in pass 2.
     pub(super) generator: Option<Box<GenRequest>>,
     /// The name of a `~generate` line with a lexical error: its labels are unknown.
     pub(super) broken_generator: Option<String>,
 }
 
-pub(super) fn is_generate(item: &Item) -> bool {
-    item.directive && item.tokens.first().is_some_and(|t| *t.text == GENERATE)
+impl Item {
+    /// The line's tokens, from the script's token vector `all`.
+    pub(super) fn tokens<'t, 'a>(&self, all: &'t [Token<'a>]) -> &'t [Token<'a>] {
+        all.get(self.tokens.clone()).unwrap_or(&[])
+    }
+}
+
+pub(super) fn is_generate(item: &Item, all: &[Token]) -> bool {
+    item.directive
+        && item
+            .tokens(all)
+            .first()
+            .is_some_and(|t| *t.text == GENERATE)
 }
 
 pub(super) const GENERATE: [char; 9] = ['~', 'g', 'e', 'n', 'e', 'r', 'a', 't', 'e'];
