@@ -8,8 +8,8 @@
 //! stolen: it fades out over [`STEAL_FADE_MS`] in a spare slot while the new note starts at
 //! once. A voice frees itself when its motion has stayed below [`FREE_LEVEL`] for
 //! [`FREE_AFTER_MS`]: the largest distance any point moved in the last sample or since the last
-//! check (a control chunk earlier) — a state check, as mi-gen~'s Drunk Triangles does with the
-//! gap between its falling mass and the triangle, not an output level. Where a point comes to
+//! check ([`MOTION_CHECK`] samples earlier) — a state check, as mi-gen~'s Drunk Triangles does
+//! with the gap between its falling mass and the triangle, not an output level. Where a point comes to
 //! rest does not matter: gravity and contacts leave static offsets (a dropped mass lies on its
 //! triangle, away from where it started).
 
@@ -24,6 +24,9 @@ pub const STEAL_FADE_MS: f64 = 5.0;
 pub const FREE_LEVEL: f64 = 1e-6;
 /// How long a voice must stay silent before it frees itself.
 pub const FREE_AFTER_MS: f64 = 250.0;
+/// Samples between two motion checks. A check reads every point of every sounding voice:
+/// once per 16-sample chunk it took 7 % of the time of 16 voices of a 100-mass string.
+pub const MOTION_CHECK: u64 = 64;
 
 /// What a voice is doing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -135,6 +138,8 @@ pub struct VoiceBank {
     clock: u64,
     pub sustain: bool,
     free_after: u64,
+    /// Samples since the last motion check.
+    unchecked: u64,
     fade_step: f64,
     /// Voices that ended since the host last asked, and how many of those did not fit.
     ended: Vec<Ended>,
@@ -203,6 +208,7 @@ impl VoiceBank {
             clock: 0,
             sustain: false,
             free_after: (FREE_AFTER_MS * 1e-3 * sample_rate) as u64,
+            unchecked: 0,
             fade_step: 1.0 / (STEAL_FADE_MS * 1e-3 * sample_rate).max(1.0),
             ended: Vec::with_capacity(capacity * 4),
             ended_dropped: 0,
@@ -554,9 +560,15 @@ impl VoiceBank {
         }
     }
 
-    /// Measures every sounding voice's motion after a span of `len` samples and frees the
-    /// ones that have stayed silent long enough. Realtime-safe.
+    /// Counts a span of `len` samples; every [`MOTION_CHECK`] samples, measures every
+    /// sounding voice's motion and frees the ones that have stayed silent long enough.
+    /// Realtime-safe.
     pub fn free_silent(&mut self, len: usize) {
+        self.unchecked += len as u64;
+        if self.unchecked < MOTION_CHECK {
+            return;
+        }
+        let len = std::mem::take(&mut self.unchecked);
         let mut levels = [0.0; LANES];
         for i in 0..self.voices.len() {
             // With lanes, a group's four levels at once, when its first voice comes up (the
