@@ -223,6 +223,46 @@ impl VoiceBank {
             .count()
     }
 
+    /// The free voice a note takes: with lanes, one in a group that already runs (its lane
+    /// is stepped anyway, so the note costs nothing more), else the first free one. Taking
+    /// the first free voice always would wake an idle group while a running one has room: an
+    /// arpeggio whose first notes have rung out runs two groups where one does.
+    fn free_slot(&self) -> Option<usize> {
+        let free = |i: &usize| self.voices[*i].state == VoiceState::Free;
+        if let Copies::Lanes(_) = &self.copies {
+            let running = (0..self.voices.len())
+                .filter(free)
+                .find(|&i| self.group_runs(i / LANES));
+            if running.is_some() {
+                return running;
+            }
+        }
+        (0..self.voices.len()).find(free)
+    }
+
+    /// Whether lane group `g` is stepped: any of its voices is not free.
+    fn group_runs(&self, g: usize) -> bool {
+        let first = g * LANES;
+        let last = (first + LANES).min(self.voices.len());
+        self.voices[first..last]
+            .iter()
+            .any(|v| v.state != VoiceState::Free)
+    }
+
+    /// How many copies of the model are stepped: lane groups with a voice that is not free,
+    /// or engines of voices that are not free.
+    #[cfg(test)]
+    fn copies_running(&self) -> usize {
+        match &self.copies {
+            Copies::Engines(_) => self
+                .voices
+                .iter()
+                .filter(|v| v.state != VoiceState::Free)
+                .count(),
+            Copies::Lanes(g) => (0..g.len()).filter(|&g| self.group_runs(g)).count(),
+        }
+    }
+
     /// The most recently started voice that is not free.
     pub fn newest(&self) -> Option<usize> {
         self.voices
@@ -276,7 +316,7 @@ impl VoiceBank {
                 self.steal(victim);
             }
         }
-        let slot = match self.voices.iter().position(|v| v.state == VoiceState::Free) {
+        let slot = match self.free_slot() {
             Some(i) => i,
             None => {
                 // Every spare slot is still fading: cut the one closest to silence.
@@ -650,5 +690,38 @@ fn voice_inputs(
                 vin[(k * len + n) * width + lane] += add;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{compile, parse, CompileOptions};
+
+    /// A note takes a free lane of a running group before it wakes an idle one.
+    #[test]
+    fn a_note_fills_a_running_lane_group_first() {
+        let text = "@g ground 0.\n@m mass 1. 0. 0.\n@s springDamper @g @m 0.01 0.001\n\
+                    @in1 frcInput @m\n@out1 posOutput @m\n";
+        let spec = parse(text).spec.expect("the script parses");
+        let engine = compile(&spec, &CompileOptions::at(48000.0)).expect("it compiles");
+        let mut bank = VoiceBank::new(&engine, 1, 1, 8, 48000.0);
+        assert!(matches!(bank.copies, Copies::Lanes(_)));
+        for n in 0..6 {
+            assert_eq!(bank.note_on(60 + n, 0, None, 0.0, 1.0), n as usize);
+        }
+        assert_eq!(bank.copies_running(), 2);
+        // The first four rang out; the fifth and sixth still sound in the second group.
+        for i in 0..4 {
+            bank.end(i);
+        }
+        assert_eq!(bank.copies_running(), 1);
+        let slot = bank.note_on(70, 0, None, 0.0, 1.0);
+        assert_eq!(slot / LANES, 1, "voice {slot} woke an idle group");
+        assert_eq!(bank.copies_running(), 1);
+        assert_eq!(bank.note_on(71, 0, None, 0.0, 1.0) / LANES, 1);
+        // The running group is full: the next note needs another.
+        assert_eq!(bank.note_on(72, 0, None, 0.0, 1.0), 0);
+        assert_eq!(bank.copies_running(), 2);
     }
 }
