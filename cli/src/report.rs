@@ -54,11 +54,16 @@ pub fn print_stability_warnings(
                 span_of(spec, &engine.info().owners[owner as usize].label)
             }
             StabilityWarning::StructureLimit { label, .. } => span_of(spec, label),
-            StabilityWarning::Unbounded { label, .. }
-            | StabilityWarning::NegativeCubic { label, .. }
-            | StabilityWarning::WeakBound { label } => {
-                // Endpoint pairs such as `g–m`: point at the first endpoint's element.
-                span_of(spec, label.split('–').next().unwrap_or(label))
+            StabilityWarning::Unbounded { .. }
+            | StabilityWarning::NegativeCubic { .. }
+            | StabilityWarning::WeakBound { .. } => {
+                // A link: at the interaction's own line, named by its label.
+                let e = w.element().and_then(|i| spec.elements.get(i));
+                if let Some(e) = e {
+                    eprintln!("{}: warning: @{}: {w}", location(path, e.span), e.label);
+                    continue;
+                }
+                Span::default()
             }
         };
         eprintln!("{}: warning: {w}", location(path, span));

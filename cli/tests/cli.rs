@@ -84,6 +84,26 @@ fn check_reports_stability_warnings_at_the_element_line() {
 }
 
 #[test]
+fn check_reports_link_warnings_at_the_interaction_line() {
+    let dir = tempfile::tempdir().unwrap();
+    // The unbounded spring is on line 4, its endpoints on lines 1 and 2.
+    let model = write(
+        dir.path(),
+        "n.mdl",
+        "@g ground 0.\n@m mass 1. 0. 0.\n# a spring that stiffens without bound\n\
+         @n3 nlSpring3 @g @m 0.1 2. 0.\n@out1 posOutput @m\n",
+    );
+    let out = ressort(&["check", model.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "a warning is not an error");
+    let stderr = text(&out.stderr);
+    let expected = format!(
+        "{}:4:1: warning: @n3: @g–m: nlSpring3 has no",
+        model.display()
+    );
+    assert!(stderr.contains(&expected), "{stderr}");
+}
+
+#[test]
 fn usage_and_io_errors_exit_2() {
     assert_eq!(
         ressort(&["check", "/nonexistent/model.mdl"]).status.code(),

@@ -190,6 +190,7 @@ impl Network {
                         net.warnings.push(StabilityWarning::NegativeCubic {
                             label: endpoints(g, i),
                             keyword: "nlContact",
+                            element: g.elements[i],
                         });
                     }
                     let kb = if c == 0.0 {
@@ -223,6 +224,7 @@ impl Network {
                             net.warnings.push(StabilityWarning::Unbounded {
                                 label: endpoints(g, i),
                                 keyword,
+                                element: g.elements[i],
                             });
                         }
                         push(g, i, k, z, &mut net.links);
@@ -248,10 +250,12 @@ impl Network {
                         net.warnings.push(StabilityWarning::NegativeCubic {
                             label: endpoints(g, i),
                             keyword: "nlSpringDamper",
+                            element: g.elements[i],
                         });
                     } else if c != 0.0 && k < s {
                         net.warnings.push(StabilityWarning::WeakBound {
                             label: endpoints(g, i),
+                            element: g.elements[i],
                         });
                     }
                     if c == 0.0 {

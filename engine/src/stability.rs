@@ -86,18 +86,35 @@ pub enum StabilityWarning {
         keyword: &'static str,
         load: f64,
     },
-    /// A nonlinear spring without a bound (`nlSpring2`/`nlSpring3` with Q ≠ 0).
+    /// A nonlinear spring without a bound (`nlSpring2`/`nlSpring3` with Q ≠ 0). For the link
+    /// warnings, `label` names the link's endpoints (`g–m`) and `element` is the index of the
+    /// interaction in the spec's elements (its label and line).
     Unbounded {
         label: String,
         keyword: &'static str,
+        element: u32,
     },
     /// A negative cubic coefficient in a bounded law: the bounded branch applies everywhere.
     NegativeCubic {
         label: String,
         keyword: &'static str,
+        element: u32,
     },
     /// `nlSpringDamper` with k < s and c ≠ 0: bounded by the weaker k (compat).
-    WeakBound { label: String },
+    WeakBound { label: String, element: u32 },
+}
+
+impl StabilityWarning {
+    /// The spec element an interaction warning is about (an index into
+    /// `ModelSpec::elements`); `None` for the warnings about masses and structures.
+    pub fn element(&self) -> Option<usize> {
+        match self {
+            StabilityWarning::Unbounded { element, .. }
+            | StabilityWarning::NegativeCubic { element, .. }
+            | StabilityWarning::WeakBound { element, .. } => Some(*element as usize),
+            StabilityWarning::MassRule(_) | StabilityWarning::StructureLimit { .. } => None,
+        }
+    }
 }
 
 impl fmt::Display for StabilityWarning {
@@ -123,16 +140,16 @@ impl fmt::Display for StabilityWarning {
                  (λ_K + 2λ_Z = {load:.3} × 4M); it may blow up although every mass passes the \
                  per-mass rule"
             ),
-            StabilityWarning::Unbounded { label, keyword } => write!(
+            StabilityWarning::Unbounded { label, keyword, .. } => write!(
                 f,
                 "@{label}: {keyword} has no stiffness bound and may become unstable for high \
                  elongation"
             ),
-            StabilityWarning::NegativeCubic { label, keyword } => write!(
+            StabilityWarning::NegativeCubic { label, keyword, .. } => write!(
                 f,
                 "@{label}: negative cubic coefficient in {keyword}; the bounded branch applies"
             ),
-            StabilityWarning::WeakBound { label } => write!(
+            StabilityWarning::WeakBound { label, .. } => write!(
                 f,
                 "@{label}: nlSpringDamper with Klim < K and KnlQ ≠ 0 is bounded by the weaker \
                  Klim"

@@ -267,6 +267,7 @@ impl<'a> Cx<'a> {
             for (r, row) in rows.iter().enumerate() {
                 group.a.push(row.a);
                 group.b.push(row.b);
+                group.elements.push(row.element as u32);
                 for (c, (expr, class)) in row.args.iter().take(ncols).enumerate() {
                     let slot = group.cols[c] + r;
                     self.bind(expr, *class, slot, row.element);

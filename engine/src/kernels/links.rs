@@ -11,6 +11,8 @@ pub(crate) struct Group {
     pub a: Vec<u32>,
     pub b: Vec<u32>,
     pub cols: Vec<usize>,
+    /// The spec element each link comes from (cold: diagnostics point at its line).
+    pub elements: Vec<u32>,
     /// Bands, in list order: runs of at least [`MIN_CHAIN`] links at positions
     /// `start..start + len` with link j = (q + j, q + j + d), as (start, len, d) — a string
     /// or a mesh row written element by element (d = 1), a mesh's links between rows
