@@ -65,6 +65,21 @@ fn invalid_utf8() {
     find(&p, C::InvalidUtf8, 2, 1);
     // Valid UTF-8 through parse_bytes is the same as parse.
     assert_eq!(parse_bytes(PRELUDE.as_bytes()), parse(PRELUDE));
+    // One report per run of bad bytes, and nothing more on its line: the U+FFFD that stands
+    // for them does not fail again as an expression or keyword character. The next lines are
+    // read as usual.
+    let p = parse_bytes(b"@m mass 1 0 0\n@n mass \xff\xfe 0 0\n@l \xffspring @m @n 0.1\n@x bad\n");
+    let on = |line: u32| {
+        p.diagnostics
+            .iter()
+            .filter(|d| d.line == line)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(on(2).len(), 1, "{:#?}", p.diagnostics);
+    assert_eq!(on(2)[0].found.as_deref(), Some("FF FE"));
+    assert_eq!(on(3).len(), 1, "{:#?}", p.diagnostics);
+    assert_eq!(on(3)[0].code, C::InvalidUtf8);
+    find(&p, C::UnknownKeyword, 4, 4);
 }
 
 #[test]

@@ -334,10 +334,25 @@ pub(crate) struct Diags {
     dropped: usize,
     /// The first error that did not fit, kept so that a blocked model always lists an error.
     first_dropped_error: Option<Diagnostic>,
+    /// Lines with invalid UTF-8, in order: their report stands for the line, and what the
+    /// U+FFFD in place of the bytes makes fail later (a bad keyword or expression character)
+    /// is not reported again.
+    utf8_lines: Vec<u32>,
 }
 
 impl Diags {
+    /// Reports invalid UTF-8 on `d.line` (see `utf8_lines`).
+    pub(crate) fn push_invalid_utf8(&mut self, d: Diagnostic) {
+        if self.utf8_lines.last() != Some(&d.line) {
+            self.utf8_lines.push(d.line);
+        }
+        self.push(d);
+    }
+
     pub(crate) fn push(&mut self, d: Diagnostic) {
+        if d.code != DiagnosticCode::InvalidUtf8 && self.utf8_lines.binary_search(&d.line).is_ok() {
+            return;
+        }
         if d.is_error() {
             self.errors += 1;
         }

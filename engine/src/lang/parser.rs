@@ -47,6 +47,7 @@ pub fn parse(text: &str) -> Parsed {
 
 /// Parses script bytes: invalid UTF-8 is reported with its line and column (each invalid
 /// sequence reads as one U+FFFD character), and the rest is parsed as text (spec §3.12 f).
+/// Adjacent invalid sequences are one report, the only one of its line.
 pub fn parse_bytes(bytes: &[u8]) -> Parsed {
     if let Ok(text) = std::str::from_utf8(bytes) {
         return parse_with(text, Diags::default());
@@ -54,26 +55,42 @@ pub fn parse_bytes(bytes: &[u8]) -> Parsed {
     let mut diags = Diags::default();
     let mut text = String::with_capacity(bytes.len());
     let mut pos = Position::default();
+    // Invalid bytes with nothing valid between them are one report: (line, col, bytes).
+    let mut run: Option<(u32, u32, Vec<String>)> = None;
+    let report = |diags: &mut Diags, (line, col, hex): (u32, u32, Vec<String>)| {
+        diags.push_invalid_utf8(
+            Diagnostic::new(
+                DiagnosticCode::InvalidUtf8,
+                line,
+                col,
+                format!("invalid UTF-8 byte sequence {}", hex.join(" ")),
+            )
+            .with_expected("UTF-8 text")
+            .with_found(hex.join(" ")),
+        );
+    };
     for chunk in bytes.utf8_chunks() {
         let valid = chunk.valid();
         text.push_str(valid);
+        if !valid.is_empty() {
+            if let Some(r) = run.take() {
+                report(&mut diags, r);
+            }
+        }
         let invalid = chunk.invalid();
         if !invalid.is_empty() {
             valid.chars().for_each(|c| pos.advance(c));
-            let hex: Vec<String> = invalid.iter().map(|b| format!("{b:02X}")).collect();
-            diags.push(
-                Diagnostic::new(
-                    DiagnosticCode::InvalidUtf8,
-                    pos.line,
-                    pos.col,
-                    format!("invalid UTF-8 byte sequence {}", hex.join(" ")),
-                )
-                .with_expected("UTF-8 text")
-                .with_found(hex.join(" ")),
-            );
+            let hex = invalid.iter().map(|b| format!("{b:02X}"));
+            match &mut run {
+                Some((_, _, bytes)) => bytes.extend(hex),
+                None => run = Some((pos.line, pos.col, hex.collect())),
+            }
             text.push('\u{FFFD}');
             pos.advance('\u{FFFD}');
         }
+    }
+    if let Some(r) = run.take() {
+        report(&mut diags, r);
     }
     parse_with(&text, diags)
 }
