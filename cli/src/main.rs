@@ -458,6 +458,17 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
         inputs[ch][0] += v;
     }
 
+    // A position input nothing feeds holds its avatar where the script puts it, as the plugin
+    // does (0 would pull the avatar there in one sample: a kick through any link on it).
+    let mut held = vec![None; info.num_inputs()];
+    for (c, uses) in info.inputs.iter().enumerate() {
+        if let (true, Some(InputUse::Position(label))) = (inputs[c].is_empty(), uses.first()) {
+            held[c] = (0..info.num_points)
+                .find(|&i| info.point_label(i) == *label)
+                .map(|i| engine.positions()[i]);
+        }
+    }
+
     let out_channels = info.num_outputs();
     let io = |e: hound::Error| usage(format!("cannot write {}: {e}", a.output.display()));
     let mut writer = float_wav(&a.output, out_channels, sr).map_err(io)?;
@@ -477,8 +488,9 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
     while done < total {
         let len = RENDER_BLOCK_FRAMES.min((total - done) as usize);
         for (c, signal) in inputs.iter().enumerate() {
+            let rest = held[c].unwrap_or(0.0);
             for n in 0..len {
-                in_buf[c * len + n] = signal.get(done as usize + n).copied().unwrap_or(0.0);
+                in_buf[c * len + n] = signal.get(done as usize + n).copied().unwrap_or(rest);
             }
         }
         engine.process(

@@ -184,6 +184,37 @@ fn render_writes_one_float_channel_per_output() {
 }
 
 #[test]
+fn render_holds_unfed_position_inputs_where_the_script_puts_them() {
+    // A finger resting on a mass through a damper: pulled to 0, it would kick the mass.
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(
+        dir.path(),
+        "p.mdl",
+        "@m mass 1. 0. 0.\n@in1 posInput 1.\n@d damper @m @in1 0.1\n@out1 posOutput @m\n",
+    );
+    let out = dir.path().join("p.wav");
+    let m = model.to_str().unwrap();
+    let render = |extra: &[&str]| -> Vec<f32> {
+        let mut args = vec!["render", m, "-o", out.to_str().unwrap(), "--samples", "500"];
+        args.extend_from_slice(extra);
+        assert!(ressort(&args).status.success());
+        hound::WavReader::open(&out)
+            .unwrap()
+            .into_samples()
+            .map(Result::unwrap)
+            .collect()
+    };
+    let held = render(&[]);
+    assert!(
+        held.iter().all(|&v| v == 0.0),
+        "an unfed avatar moved the mass"
+    );
+    // A fed input still drives it: an impulse feeds 0 after its first sample.
+    let fed = render(&["--impulse", "in1=1"]);
+    assert!(fed.iter().any(|&v| v != 0.0));
+}
+
+#[test]
 fn render_feeds_wav_inputs() {
     // A force signal from a file drives the hammer like the impulse does.
     let dir = tempfile::tempdir().unwrap();
