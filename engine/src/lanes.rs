@@ -188,6 +188,35 @@ impl LaneEngine {
         self.tripped[lane] = false;
     }
 
+    /// Copies lane `from` of `src` into lane `to` of `self`: its state, arguments,
+    /// coefficients, gains, guard and flush phase, so that the lane goes on exactly as it would
+    /// have in `src` (the voice bank packs sounding voices into fewer groups). Both groups run
+    /// the same model with the same parameters. Realtime-safe.
+    pub fn take_lane(&mut self, to: usize, src: &LaneEngine, from: usize) {
+        if to >= LANES || from >= LANES {
+            return;
+        }
+        let copy = |dst: &mut [Lanes], s: &[Lanes]| {
+            for (d, s) in dst.iter_mut().zip(s) {
+                d[to] = s[from];
+            }
+        };
+        copy(&mut self.args, &src.args);
+        copy(&mut self.a, &src.a);
+        copy(&mut self.b, &src.b);
+        copy(&mut self.inv_m, &src.inv_m);
+        copy(&mut self.gravity, &src.gravity);
+        copy(&mut self.x, &src.x);
+        copy(&mut self.xp, &src.xp);
+        copy(&mut self.f, &src.f);
+        copy(&mut self.last, &src.last);
+        self.gains[to] = src.gains[from];
+        self.seen[to] = src.seen[from];
+        self.gains_dirty[to] = src.gains_dirty[from];
+        self.samples_since_reset[to] = src.samples_since_reset[from];
+        self.tripped[to] = src.tripped[from];
+    }
+
     /// Whether lane `lane`'s guard has tripped (a non-finite or runaway value): its outputs
     /// stay 0 until [`LaneEngine::reset_lane`].
     pub fn is_tripped(&self, lane: usize) -> bool {

@@ -656,6 +656,82 @@ impl VoiceBank {
                 v.quiet = 0;
             }
         }
+        self.pack();
+    }
+
+    /// Packs the voices into as few lane groups as hold them: while more groups run than
+    /// their voices need, the voices of the emptiest running group move to free lanes of the
+    /// fullest ones that have room. A group steps all its lanes while one voice sounds, so
+    /// five voices spread over four groups cost sixteen lanes, packed eight. A moved voice
+    /// goes on exactly as it would have (`LaneEngine::take_lane`); only the order in which
+    /// the voices are summed changes. Realtime-safe.
+    fn pack(&mut self) {
+        let Copies::Lanes(groups) = &mut self.copies else {
+            return;
+        };
+        let voices = &mut self.voices;
+        let busy = |voices: &[Voice], g: usize| {
+            let first = g * LANES;
+            let last = (first + LANES).min(voices.len());
+            voices[first..last]
+                .iter()
+                .filter(|v| v.state != VoiceState::Free)
+                .count()
+        };
+        let size = |voices: &[Voice], g: usize| ((g + 1) * LANES).min(voices.len()) - g * LANES;
+        loop {
+            // The emptiest running group.
+            let (mut running, mut total) = (0, 0);
+            let mut from: Option<(usize, usize)> = None;
+            for g in 0..groups.len() {
+                let n = busy(voices, g);
+                if n > 0 {
+                    running += 1;
+                    total += n;
+                    if from.is_none_or(|(_, m)| n < m) {
+                        from = Some((g, n));
+                    }
+                }
+            }
+            let Some((src, n_src)) = from else {
+                return;
+            };
+            if running <= total.div_ceil(LANES) {
+                return;
+            }
+            // The fullest other running group with a free lane (one exists: the others hold
+            // all but the emptiest group's voices in fewer lanes than they have).
+            let into = (0..groups.len())
+                .filter(|&g| g != src)
+                .map(|g| (g, busy(voices, g)))
+                .filter(|&(g, n)| n > 0 && n < size(voices, g))
+                .max_by_key(|&(_, n)| n);
+            let Some((dst, n_dst)) = into else {
+                return;
+            };
+            if n_dst < n_src {
+                return;
+            }
+            // One voice of `src` into the first free lane of `dst`.
+            let Some(i) = (src * LANES..(src * LANES + LANES).min(voices.len()))
+                .find(|&i| voices[i].state != VoiceState::Free)
+            else {
+                return;
+            };
+            let Some(j) = (dst * LANES..(dst * LANES + LANES).min(voices.len()))
+                .find(|&j| voices[j].state == VoiceState::Free)
+            else {
+                return;
+            };
+            let (a, b) = groups.split_at_mut(src.max(dst));
+            let (to, from_group) = if dst < src {
+                (&mut a[dst], &b[0])
+            } else {
+                (&mut b[0], &a[src])
+            };
+            to.take_lane(j % LANES, from_group, i % LANES);
+            voices.swap(i, j);
+        }
     }
 }
 
@@ -698,14 +774,67 @@ mod tests {
     use super::*;
     use crate::{compile, parse, CompileOptions};
 
-    /// A note takes a free lane of a running group before it wakes an idle one.
-    #[test]
-    fn a_note_fills_a_running_lane_group_first() {
+    fn oscillator() -> crate::Engine {
         let text = "@g ground 0.\n@m mass 1. 0. 0.\n@s springDamper @g @m 0.01 0.001\n\
                     @in1 frcInput @m\n@out1 posOutput @m\n";
         let spec = parse(text).spec.expect("the script parses");
-        let engine = compile(&spec, &CompileOptions::at(48000.0)).expect("it compiles");
-        let mut bank = VoiceBank::new(&engine, 1, 1, 8, 48000.0);
+        compile(&spec, &CompileOptions::at(48000.0)).expect("it compiles")
+    }
+
+    /// Runs `spans` chunks of the bank, struck on input 1.
+    fn run(bank: &mut VoiceBank, spans: usize) {
+        let inputs = [0.0; CHUNK];
+        let mut outputs = [0.0; CHUNK];
+        for _ in 0..spans {
+            outputs.fill(0.0);
+            bank.process(CHUNK, &inputs, &mut outputs, Some(0), 1.0, None);
+        }
+    }
+
+    /// Voices spread over four groups are packed into two, and every voice goes on bit for
+    /// bit as it would have where it was.
+    #[test]
+    fn sounding_voices_are_packed_into_few_lane_groups() {
+        let mut bank = VoiceBank::new(&oscillator(), 1, 1, 16, 48000.0);
+        for n in 0..16u8 {
+            // Different strikes, one after the other: every voice in its own state.
+            let i = bank.note_on(40 + n, 0, None, 0.0, 0.05 * f64::from(n + 1));
+            // Each voice tuned: its own stiffness and damping arguments.
+            let mut copy = bank.copy(i);
+            copy.set_class_gain(ScaleClass::Stiffness, 1.0 + 0.1 * f64::from(n));
+            copy.set_class_gain(ScaleClass::Damping, 2.0 - 0.05 * f64::from(n));
+            run(&mut bank, 1);
+        }
+        // Left sounding: one voice in group 0, two in group 1, one in 2 and one in 3.
+        for i in [1, 2, 3, 4, 5, 8, 9, 10, 12, 13, 15] {
+            bank.end(i);
+        }
+        let mut packed = bank.clone();
+        packed.pack();
+        assert_eq!(bank.copies_running(), 4);
+        assert_eq!(packed.copies_running(), 2);
+        run(&mut bank, 40);
+        run(&mut packed, 40);
+        let state = |b: &mut VoiceBank, note: u8| {
+            let i = (0..b.voices.len())
+                .find(|&i| b.voices[i].state != VoiceState::Free && b.voices[i].note == note)
+                .expect("the voice still sounds");
+            let (x, xp) = b.positions(i);
+            (x.to_vec(), xp.to_vec())
+        };
+        for note in [40, 46, 47, 51, 54] {
+            assert_eq!(
+                state(&mut bank, note),
+                state(&mut packed, note),
+                "note {note}"
+            );
+        }
+    }
+
+    /// A note takes a free lane of a running group before it wakes an idle one.
+    #[test]
+    fn a_note_fills_a_running_lane_group_first() {
+        let mut bank = VoiceBank::new(&oscillator(), 1, 1, 8, 48000.0);
         assert!(matches!(bank.copies, Copies::Lanes(_)));
         for n in 0..6 {
             assert_eq!(bank.note_on(60 + n, 0, None, 0.0, 1.0), n as usize);
