@@ -9,9 +9,9 @@
 //! once. A voice frees itself when its motion has stayed below [`FREE_LEVEL`] for
 //! [`FREE_AFTER_MS`]: the largest distance any point moved in the last sample or since the last
 //! check ([`MOTION_CHECK`] samples earlier) — a state check, as mi-gen~'s Drunk Triangles does
-//! with the gap between its falling mass and the triangle, not an output level. Where a point comes to
-//! rest does not matter: gravity and contacts leave static offsets (a dropped mass lies on its
-//! triangle, away from where it started).
+//! with the gap between its falling mass and the triangle, not an output level. Where a point
+//! comes to rest does not matter: gravity and contacts leave static offsets (a dropped mass
+//! lies on its triangle, away from where it started).
 
 use super::controls::{Controlled, Gains, TuneKey, TuningMemo};
 use super::CHUNK;
