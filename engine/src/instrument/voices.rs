@@ -18,6 +18,8 @@ use super::CHUNK;
 use crate::lanes::{LaneEngine, LANES};
 use crate::{Engine, ParamId, ScaleClass};
 
+mod upkeep;
+
 /// The fade-out of a stolen voice.
 pub const STEAL_FADE_MS: f64 = 5.0;
 /// Motion (model units) below which a voice counts as silent.
@@ -597,140 +599,6 @@ impl VoiceBank {
             for (k, o) in outputs[..n_out * len].iter_mut().enumerate() {
                 *o += src[k * width + lane];
             }
-        }
-    }
-
-    /// Counts a span of `len` samples; every [`MOTION_CHECK`] samples, measures every
-    /// sounding voice's motion and frees the ones that have stayed silent long enough.
-    /// Realtime-safe.
-    pub fn free_silent(&mut self, len: usize) {
-        self.unchecked += len as u64;
-        if self.unchecked < MOTION_CHECK {
-            return;
-        }
-        let len = std::mem::take(&mut self.unchecked);
-        let mut levels = [0.0; LANES];
-        for i in 0..self.voices.len() {
-            // With lanes, a group's four levels at once, when its first voice comes up (the
-            // positions the group last saw are its own, not the voices' `last`).
-            if let Copies::Lanes(groups) = &mut self.copies {
-                if i % LANES == 0 {
-                    let first = i;
-                    let last = (i + LANES).min(self.voices.len());
-                    if self.voices[first..last]
-                        .iter()
-                        .any(|v| matches!(v.state, VoiceState::Held | VoiceState::Released))
-                    {
-                        levels = groups[i / LANES].motion();
-                    }
-                }
-            }
-            let v = &mut self.voices[i];
-            if !matches!(v.state, VoiceState::Held | VoiceState::Released) {
-                continue;
-            }
-            if v.pressure > 0.0 {
-                // A key that still presses drives its voice: it stays.
-                v.quiet = 0;
-                continue;
-            }
-            let level = match &self.copies {
-                Copies::Engines(e) => {
-                    let (x, xp) = (e[i].positions(), e[i].delayed_positions());
-                    let mut level: f64 = 0.0;
-                    for ((x, xp), last) in x.iter().zip(xp).zip(v.last.iter_mut()) {
-                        level = level.max((x - xp).abs()).max((x - *last).abs());
-                        *last = *x;
-                    }
-                    level
-                }
-                Copies::Lanes(_) => levels[i % LANES],
-            };
-            v.level = level;
-            if level < FREE_LEVEL {
-                v.quiet += len as u64;
-                if v.quiet >= self.free_after {
-                    self.end(i);
-                }
-            } else {
-                v.quiet = 0;
-            }
-        }
-        self.pack();
-    }
-
-    /// Packs the voices into as few lane groups as hold them: while more groups run than
-    /// their voices need, the voices of the emptiest running group move to free lanes of the
-    /// fullest ones that have room. A group steps all its lanes while one voice sounds, so
-    /// five voices spread over four groups cost sixteen lanes, packed eight. A moved voice
-    /// goes on exactly as it would have (`LaneEngine::take_lane`); only the order in which
-    /// the voices are summed changes. Realtime-safe.
-    fn pack(&mut self) {
-        let Copies::Lanes(groups) = &mut self.copies else {
-            return;
-        };
-        let voices = &mut self.voices;
-        let busy = |voices: &[Voice], g: usize| {
-            let first = g * LANES;
-            let last = (first + LANES).min(voices.len());
-            voices[first..last]
-                .iter()
-                .filter(|v| v.state != VoiceState::Free)
-                .count()
-        };
-        let size = |voices: &[Voice], g: usize| ((g + 1) * LANES).min(voices.len()) - g * LANES;
-        loop {
-            // The emptiest running group.
-            let (mut running, mut total) = (0, 0);
-            let mut from: Option<(usize, usize)> = None;
-            for g in 0..groups.len() {
-                let n = busy(voices, g);
-                if n > 0 {
-                    running += 1;
-                    total += n;
-                    if from.is_none_or(|(_, m)| n < m) {
-                        from = Some((g, n));
-                    }
-                }
-            }
-            let Some((src, n_src)) = from else {
-                return;
-            };
-            if running <= total.div_ceil(LANES) {
-                return;
-            }
-            // The fullest other running group with a free lane (one exists: the others hold
-            // all but the emptiest group's voices in fewer lanes than they have).
-            let into = (0..groups.len())
-                .filter(|&g| g != src)
-                .map(|g| (g, busy(voices, g)))
-                .filter(|&(g, n)| n > 0 && n < size(voices, g))
-                .max_by_key(|&(_, n)| n);
-            let Some((dst, n_dst)) = into else {
-                return;
-            };
-            if n_dst < n_src {
-                return;
-            }
-            // One voice of `src` into the first free lane of `dst`.
-            let Some(i) = (src * LANES..(src * LANES + LANES).min(voices.len()))
-                .find(|&i| voices[i].state != VoiceState::Free)
-            else {
-                return;
-            };
-            let Some(j) = (dst * LANES..(dst * LANES + LANES).min(voices.len()))
-                .find(|&j| voices[j].state == VoiceState::Free)
-            else {
-                return;
-            };
-            let (a, b) = groups.split_at_mut(src.max(dst));
-            let (to, from_group) = if dst < src {
-                (&mut a[dst], &b[0])
-            } else {
-                (&mut b[0], &a[src])
-            };
-            to.take_lane(j % LANES, from_group, i % LANES);
-            voices.swap(i, j);
         }
     }
 }
