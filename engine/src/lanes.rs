@@ -503,19 +503,10 @@ impl LaneEngine {
             });
         }
         for r in &self.template.force_inputs {
-            let ch = r.channel as usize;
+            // A silent or missing channel adds 0, as the plain engine does (−0 + 0 = +0).
             let fi = &mut f[r.index as usize];
-            if ch >= in_channels {
-                // A silent channel adds 0 as the plain engine does (−0 + 0 = +0).
-                for v in fi.iter_mut() {
-                    *v += 0.0;
-                }
-                continue;
-            }
-            let at = (ch * frames + n) * LANES;
-            for l in 0..LANES {
-                let v = inputs[at + l];
-                fi[l] += if v.is_finite() { v } else { 0.0 };
+            for (l, v) in fi.iter_mut().enumerate() {
+                *v += input(r.channel, l);
             }
         }
         // Stage 5: connection-point forces onto the macro nodes.

@@ -25,6 +25,25 @@ fn lane_node_law(args: &[Lanes], m: usize, zo: usize) -> (Lanes, Lanes, Lanes) {
     out
 }
 
+/// Node law of a macro's moving nodes `nodes` (`kernels::macros::node_law`): X[n+1] =
+/// a·X + b·X̃ + F·(1/M), per lane.
+#[inline(always)]
+fn update_nodes(
+    (a, b, inv_m): (Lanes, Lanes, Lanes),
+    x: &mut [Lanes],
+    xp: &mut [Lanes],
+    f: &[Lanes],
+    nodes: std::ops::Range<usize>,
+) {
+    for i in nodes {
+        for l in 0..super::LANES {
+            let next = a[l] * x[i][l] + b[l] * xp[i][l] + f[i][l] * inv_m[l];
+            xp[i][l] = x[i][l];
+            x[i][l] = next;
+        }
+    }
+}
+
 /// A string, chain or stiff string (`kernels::macros`: `update_line_nodes`, `chain_links`,
 /// then for a stiff string `stiffness_links`).
 #[inline(always)]
@@ -37,7 +56,7 @@ pub(super) fn line_step(
     s: &mut [Lanes],
     args: &[Lanes],
 ) {
-    let (a, b, inv_m) = lane_node_law(args, mac.slots.m, mac.slots.zo);
+    let law = lane_node_law(args, mac.slots.m, mac.slots.zo);
     let n = mac.len;
     let (x, xp, f) = (
         &mut x[mac.base..mac.base + n],
@@ -49,13 +68,7 @@ pub(super) fn line_step(
     } else {
         (0, n)
     };
-    for i in lo..hi {
-        for l in 0..super::LANES {
-            let next = a[l] * x[i][l] + b[l] * xp[i][l] + f[i][l] * inv_m[l];
-            xp[i][l] = x[i][l];
-            x[i][l] = next;
-        }
-    }
+    update_nodes(law, x, xp, f, lo..hi);
     if n < 2 {
         f.fill([0.0; super::LANES]);
     } else {
@@ -105,7 +118,7 @@ pub(super) fn mesh_step(
     s: &mut [Lanes],
     args: &[Lanes],
 ) {
-    let (a, b, inv_m) = lane_node_law(args, mac.slots.m, mac.slots.zo);
+    let law = lane_node_law(args, mac.slots.m, mac.slots.zo);
     let (k, z) = (args[mac.slots.k], args[mac.slots.z]);
     let (len, w) = (mac.length, mac.width);
     let n = len * w;
@@ -115,13 +128,7 @@ pub(super) fn mesh_step(
         &mut f[mac.base..mac.base + n],
     );
     let x_edge = x[0];
-    for i in 0..n {
-        for l in 0..super::LANES {
-            let next = a[l] * x[i][l] + b[l] * xp[i][l] + f[i][l] * inv_m[l];
-            xp[i][l] = x[i][l];
-            x[i][l] = next;
-        }
-    }
+    update_nodes(law, x, xp, f, 0..n);
     for &p in &mac.pinned {
         x[p as usize] = x_edge;
         xp[p as usize] = x_edge;
