@@ -244,9 +244,7 @@ impl VoiceBank {
 
     /// Whether lane group `g` is stepped: any of its voices is not free.
     fn group_runs(&self, g: usize) -> bool {
-        let first = g * LANES;
-        let last = (first + LANES).min(self.voices.len());
-        self.voices[first..last]
+        self.voices[group(g, self.voices.len())]
             .iter()
             .any(|v| v.state != VoiceState::Free)
     }
@@ -525,14 +523,10 @@ impl VoiceBank {
             }
             Copies::Lanes(groups) => {
                 for (g, group) in groups.iter_mut().enumerate() {
-                    let first = g * LANES;
-                    let last = (first + LANES).min(self.voices.len());
-                    if self.voices[first..last]
-                        .iter()
-                        .all(|v| v.state == VoiceState::Free)
-                    {
+                    if !self.group_runs(g) {
                         continue;
                     }
+                    let (first, last) = (g * LANES, (g * LANES + LANES).min(self.voices.len()));
                     // Every lane hears the host's inputs, plus its own strike and pressure.
                     let vin = &mut self.inputs[..n_in * len * LANES];
                     for (k, x) in inputs.iter().enumerate() {
@@ -601,6 +595,11 @@ impl VoiceBank {
             }
         }
     }
+}
+
+/// The voices of lane group `g` in a bank of `voices` voices.
+fn group(g: usize, voices: usize) -> std::ops::Range<usize> {
+    g * LANES..(g * LANES + LANES).min(voices)
 }
 
 /// Adds voice `v`'s strike (on the note input's first sample) and pressure (on every sample of

@@ -1,7 +1,7 @@
 //! Voice upkeep between spans: the rest check that frees silent voices, and the packing of
 //! sounding voices into as few lane groups as hold them.
 
-use super::{Copies, Voice, VoiceBank, VoiceState, FREE_LEVEL, MOTION_CHECK};
+use super::{group, Copies, Voice, VoiceBank, VoiceState, FREE_LEVEL, MOTION_CHECK};
 use crate::lanes::LANES;
 
 impl VoiceBank {
@@ -20,9 +20,7 @@ impl VoiceBank {
             // positions the group last saw are its own, not the voices' `last`).
             if let Copies::Lanes(groups) = &mut self.copies {
                 if i % LANES == 0 {
-                    let first = i;
-                    let last = (i + LANES).min(self.voices.len());
-                    if self.voices[first..last]
+                    if self.voices[group(i / LANES, self.voices.len())]
                         .iter()
                         .any(|v| matches!(v.state, VoiceState::Held | VoiceState::Released))
                     {
@@ -76,14 +74,11 @@ impl VoiceBank {
         };
         let voices = &mut self.voices;
         let busy = |voices: &[Voice], g: usize| {
-            let first = g * LANES;
-            let last = (first + LANES).min(voices.len());
-            voices[first..last]
+            voices[group(g, voices.len())]
                 .iter()
                 .filter(|v| v.state != VoiceState::Free)
                 .count()
         };
-        let size = |voices: &[Voice], g: usize| ((g + 1) * LANES).min(voices.len()) - g * LANES;
         loop {
             // The emptiest running group.
             let (mut running, mut total) = (0, 0);
@@ -98,7 +93,7 @@ impl VoiceBank {
                     }
                 }
             }
-            let Some((src, n_src)) = from else {
+            let Some((src, _)) = from else {
                 return;
             };
             if running <= total.div_ceil(LANES) {
@@ -109,22 +104,17 @@ impl VoiceBank {
             let into = (0..groups.len())
                 .filter(|&g| g != src)
                 .map(|g| (g, busy(voices, g)))
-                .filter(|&(g, n)| n > 0 && n < size(voices, g))
+                .filter(|&(g, n)| n > 0 && n < group(g, voices.len()).len())
                 .max_by_key(|&(_, n)| n);
-            let Some((dst, n_dst)) = into else {
+            let Some((dst, _)) = into else {
                 return;
             };
-            if n_dst < n_src {
-                return;
-            }
             // One voice of `src` into the first free lane of `dst`.
-            let Some(i) = (src * LANES..(src * LANES + LANES).min(voices.len()))
-                .find(|&i| voices[i].state != VoiceState::Free)
+            let Some(i) = group(src, voices.len()).find(|&i| voices[i].state != VoiceState::Free)
             else {
                 return;
             };
-            let Some(j) = (dst * LANES..(dst * LANES + LANES).min(voices.len()))
-                .find(|&j| voices[j].state == VoiceState::Free)
+            let Some(j) = group(dst, voices.len()).find(|&j| voices[j].state == VoiceState::Free)
             else {
                 return;
             };
