@@ -19,13 +19,12 @@ impl VoiceBank {
             // With lanes, a group's four levels at once, when its first voice comes up (the
             // positions the group last saw are its own, not the voices' `last`).
             if let Copies::Lanes(groups) = &mut self.copies {
-                if i % LANES == 0 {
-                    if self.voices[group(i / LANES, self.voices.len())]
+                if i % LANES == 0
+                    && self.voices[group(i / LANES, self.voices.len())]
                         .iter()
                         .any(|v| matches!(v.state, VoiceState::Held | VoiceState::Released))
-                    {
-                        levels = groups[i / LANES].motion();
-                    }
+                {
+                    levels = groups[i / LANES].motion();
                 }
             }
             let v = &mut self.voices[i];
