@@ -460,14 +460,7 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
 
     // A position input nothing feeds holds its avatar where the script puts it, as the plugin
     // does (0 would pull the avatar there in one sample: a kick through any link on it).
-    let mut held = vec![None; info.num_inputs()];
-    for (c, uses) in info.inputs.iter().enumerate() {
-        if let (true, Some(InputUse::Position(label))) = (inputs[c].is_empty(), uses.first()) {
-            held[c] = (0..info.num_points)
-                .find(|&i| info.point_label(i) == *label)
-                .map(|i| engine.positions()[i]);
-        }
-    }
+    let rests = ressort_engine::instrument::prepare::input_rests(&engine);
 
     let out_channels = info.num_outputs();
     let io = |e: hound::Error| usage(format!("cannot write {}: {e}", a.output.display()));
@@ -488,7 +481,8 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
     while done < total {
         let len = RENDER_BLOCK_FRAMES.min((total - done) as usize);
         for (c, signal) in inputs.iter().enumerate() {
-            let rest = held[c].unwrap_or(0.0);
+            // An input fed by a file or an impulse reads 0 after its end.
+            let rest = if signal.is_empty() { rests[c] } else { 0.0 };
             for n in 0..len {
                 in_buf[c * len + n] = signal.get(done as usize + n).copied().unwrap_or(rest);
             }

@@ -126,18 +126,7 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
             None => InputRole::Unused,
         })
         .collect();
-    // Avatars rest at their declared position: a silent input holds them there.
-    let rest: Vec<f64> = info
-        .inputs
-        .iter()
-        .map(|uses| match uses.first() {
-            Some(InputUse::Position(label)) => (0..info.num_points)
-                .find(|&i| info.point_label(i) == *label)
-                .map(|i| engine.positions()[i])
-                .unwrap_or(0.0),
-            _ => 0.0,
-        })
-        .collect();
+    let rest = input_rests(&engine);
     if let Some(k) = settings.note_input {
         if roles.get(k as usize) != Some(&InputRole::Force) {
             let line = text
@@ -223,6 +212,23 @@ pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rej
 /// [`crate::modes::DEFAULT_SPARSE_COUNT`] above (about 2 s for the 150 × 150 plate). Models the
 /// analysis cannot read (a note input with no linear path) fall back to the impulse
 /// response's strongest peak ([`estimate_pitch`]), within its work budget.
+/// What each input channel of `engine` holds when nothing feeds it: a position input its
+/// avatar's declared position (so a silent input leaves the avatar where the script puts it),
+/// every other input 0.
+pub fn input_rests(engine: &Engine) -> Vec<f64> {
+    let info = engine.info();
+    info.inputs
+        .iter()
+        .map(|uses| match uses.first() {
+            Some(InputUse::Position(label)) => (0..info.num_points)
+                .find(|&i| info.point_label(i) == *label)
+                .map(|i| engine.positions()[i])
+                .unwrap_or(0.0),
+            _ => 0.0,
+        })
+        .collect()
+}
+
 fn reference_pitch(
     engine: &mut Engine,
     note_input: Option<usize>,
