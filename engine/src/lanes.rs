@@ -1,6 +1,6 @@
 //! Voice lanes (issue 12): [`LANES`] copies of one compiled model stepped together, the copy
-//! the fastest axis of the state (`x[point][lane]`), so that every kernel runs four voices per
-//! instruction. The copies share the structure and the parameters; each lane has its own
+//! the fastest axis of the state (`x[point][lane]`), so that every kernel runs all the lanes
+//! in one or two vector instructions (`vector`). The copies share the structure and the parameters; each lane has its own
 //! state, class gains (its tuning, Release, polyphonic modulation), inputs, outputs, guard and
 //! flush phase.
 //!
@@ -19,10 +19,15 @@ use crate::laws;
 use crate::spec::ScaleClass;
 use crate::{Engine, ParamError, ParamId};
 
+mod links;
 mod structures;
+mod vector;
+
+use links::{apply, per_lane, Linear, PerLane};
+use vector::Ops;
 
 /// Voices per lane group.
-pub const LANES: usize = 4;
+pub const LANES: usize = 8;
 
 /// The largest model that runs in lanes. A group steps all its lanes while any of them
 /// sounds, so a model whose one voice already fills the vectors costs up to four voices' work
@@ -31,7 +36,40 @@ pub const LANES: usize = 4;
 /// 269 with 2; small models gain at every count (Drunk Triangles: 312 against 615 ns with 16).
 pub const MAX_LANE_POINTS: usize = 256;
 
-type Lanes = [f64; LANES];
+/// The shortest run of singles with equal coefficients that the mass pass runs reading them
+/// once ([`LaneEngine::find_mass_runs`]).
+const UNIFORM_MASS_RUN: usize = 8;
+
+/// One f64 per lane, aligned to a cache line so that no vector load or store of a lane
+/// group's value splits one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+struct Lanes([f64; LANES]);
+
+impl Lanes {
+    const ZERO: Lanes = Lanes([0.0; LANES]);
+
+    /// `v` in every lane.
+    #[inline(always)]
+    fn splat(v: f64) -> Lanes {
+        Lanes([v; LANES])
+    }
+}
+
+impl std::ops::Deref for Lanes {
+    type Target = [f64; LANES];
+    #[inline(always)]
+    fn deref(&self) -> &[f64; LANES] {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for Lanes {
+    #[inline(always)]
+    fn deref_mut(&mut self) -> &mut [f64; LANES] {
+        &mut self.0
+    }
+}
 
 /// [`LANES`] voices of one model. See the module documentation.
 #[derive(Clone, Debug)]
@@ -54,15 +92,20 @@ pub struct LaneEngine {
     x: Vec<Lanes>,
     xp: Vec<Lanes>,
     f: Vec<Lanes>,
+    /// The singles in runs that cover them in order, as (start, end, uniform): a uniform run's
+    /// singles have the same coefficients, lane by lane, and the mass pass reads them once
+    /// ([`LaneEngine::find_mass_runs`]). The first `mass_run_count`; room for one run per
+    /// single (a length, not a capacity, so that clones keep it).
+    mass_runs: Vec<(u32, u32, bool)>,
+    mass_run_count: usize,
+    /// A single's coefficients changed since the runs were found.
+    mass_runs_stale: bool,
     /// Positions at the last [`LaneEngine::motion`].
     last: Vec<Lanes>,
-    /// Link forces of the longest chain (see `Group::apply`).
-    chain: Vec<Lanes>,
     /// Connection points: the template's, placed by the coordinates every lane shares.
     proxies: Proxies,
-    /// Node velocities and link forces of the macro being computed.
+    /// Node velocities of the mesh being computed.
     scratch_v: Vec<Lanes>,
-    scratch_s: Vec<Lanes>,
     params_dirty: bool,
     gains_dirty: [bool; LANES],
     /// The class factors each lane's arguments were last computed with.
@@ -81,7 +124,7 @@ impl LaneEngine {
             && engine.points.x.len() <= MAX_LANE_POINTS
     }
 
-    /// Four voices of `template`, every lane at rest with the template's class gains.
+    /// [`LANES`] voices of `template`, every lane at rest with the template's class gains.
     /// Allocates: call it off the audio thread. `None` when the model is not supported.
     pub fn new(template: &Engine) -> Option<LaneEngine> {
         if !LaneEngine::supports(template) {
@@ -90,32 +133,33 @@ impl LaneEngine {
         let mut template = template.clone();
         template.reset();
         let n = template.points.x.len();
-        let slots = template.args.len();
         // Slots no binding writes keep the values the compiler gave them.
-        let args = template.args.iter().map(|&v| [v; LANES]).collect();
-        let chain_len = template.points.s.len();
+        let args = template.args.iter().map(|&v| Lanes([v; LANES])).collect();
         let singles = template.singles.len();
         let largest_macro = template.macros.scratch_v.len();
         let proxies = template.proxies.clone();
-        let zero = [0.0; LANES];
+        // Slots no binding writes keep the compiler's value, as `ControlArgs::raw`.
+        let raw = template.control.raw().to_vec();
+        let zero = Lanes::ZERO;
         let mut lanes = LaneEngine {
             gains: [template.class_gain; LANES],
             template,
             rest_stale: false,
-            raw: vec![0.0; slots],
+            raw,
             args,
             a: vec![zero; singles],
             b: vec![zero; singles],
             inv_m: vec![zero; singles],
             gravity: vec![zero; singles],
+            mass_runs: vec![(0, 0, false); singles],
+            mass_run_count: 0,
+            mass_runs_stale: true,
             x: vec![zero; n],
             xp: vec![zero; n],
             f: vec![zero; n],
             last: vec![zero; n],
-            chain: vec![zero; chain_len],
             proxies,
             scratch_v: vec![zero; largest_macro],
-            scratch_s: vec![zero; largest_macro],
             params_dirty: true,
             gains_dirty: [true; LANES],
             seen: [[0.0; NUM_ARG_CLASSES]; LANES],
@@ -206,6 +250,7 @@ impl LaneEngine {
         copy(&mut self.b, &src.b);
         copy(&mut self.inv_m, &src.inv_m);
         copy(&mut self.gravity, &src.gravity);
+        self.mass_runs_stale = true;
         copy(&mut self.x, &src.x);
         copy(&mut self.xp, &src.xp);
         copy(&mut self.f, &src.f);
@@ -237,16 +282,24 @@ impl LaneEngine {
     /// How far each lane moved: the largest distance any point moved in the last sample or
     /// since the last call, per lane (the voice bank's rest detection). Realtime-safe.
     pub fn motion(&mut self) -> [f64; LANES] {
-        let mut level = [0.0f64; LANES];
-        for ((x, xp), last) in self.x.iter().zip(&self.xp).zip(&mut self.last) {
-            for l in 0..LANES {
-                level[l] = level[l]
-                    .max((x[l] - xp[l]).abs())
-                    .max((x[l] - last[l]).abs());
-                last[l] = x[l];
+        struct Motion<'a>(&'a mut LaneEngine);
+        impl pulp::WithSimd for Motion<'_> {
+            type Output = Lanes;
+            #[inline(always)]
+            fn with_simd<S: pulp::Simd>(self, simd: S) -> Lanes {
+                let o = Ops(simd);
+                let lanes = self.0;
+                let mut level = Lanes::ZERO;
+                for ((x, xp), last) in lanes.x.iter().zip(&lanes.xp).zip(&mut lanes.last) {
+                    level = o.max_abs(o.sub(*x, *xp), level);
+                    level = o.max_abs(o.sub(*x, *last), level);
+                    *last = *x;
+                }
+                level
             }
         }
-        level
+        let arch = self.arch;
+        arch.dispatch(Motion(self)).0
     }
 
     /// Re-evaluates the arguments and coefficients after a parameter or gain change. A
@@ -263,6 +316,9 @@ impl LaneEngine {
             }
             self.gains_dirty = [true; LANES];
             self.params_dirty = false;
+            // Which bands read one set of arguments: compared before the class factors, so
+            // that they stay equal in every lane whatever its gains (as `Engine` does).
+            t.interactions.find_uniform(&self.raw);
         }
         for l in 0..LANES {
             if !self.gains_dirty[l] {
@@ -281,6 +337,7 @@ impl LaneEngine {
                     o[i][l] = v;
                 }
             };
+            self.mass_runs_stale = true;
             let mut out = [&mut self.a, &mut self.b, &mut self.inv_m, &mut self.gravity];
             if full {
                 for bind in &t.control.bindings {
@@ -325,6 +382,36 @@ impl LaneEngine {
         }
     }
 
+    /// Splits the singles into runs: at least [`UNIFORM_MASS_RUN`] consecutive singles whose
+    /// four coefficients are equal, bit for bit and lane by lane (a string's masses, each
+    /// lane with its own tuning), and the singles between such runs. Never allocates.
+    fn find_mass_runs(&mut self) {
+        let bits = |v: &Lanes| v.map(f64::to_bits);
+        let coefficients =
+            |i: usize| [&self.a[i], &self.b[i], &self.inv_m[i], &self.gravity[i]].map(bits);
+        let runs = &mut self.mass_runs;
+        let mut count = 0usize;
+        let n = self.a.len();
+        let mut start = 0;
+        while start < n {
+            let first = coefficients(start);
+            let end = (start + 1..n)
+                .find(|&i| coefficients(i) != first)
+                .unwrap_or(n);
+            let uniform = end - start >= UNIFORM_MASS_RUN;
+            match count.checked_sub(1).map(|last| &mut runs[last]) {
+                Some((_, last_end, false)) if !uniform => *last_end = end as u32,
+                _ => {
+                    runs[count] = (start as u32, end as u32, uniform);
+                    count += 1;
+                }
+            }
+            start = end;
+        }
+        self.mass_run_count = count;
+        self.mass_runs_stale = false;
+    }
+
     /// Runs `frames` samples of every lane. `inputs` holds the input channels one after the
     /// other, each `frames` samples of [`LANES`] values (`inputs[(c·frames + n)·LANES + l]`);
     /// `outputs` the same for the output channels. Non-finite inputs count as 0; a tripped
@@ -337,6 +424,9 @@ impl LaneEngine {
         if self.params_dirty || self.gains_dirty.iter().any(|d| *d) {
             self.refresh();
         }
+        if self.mass_runs_stale {
+            self.find_mass_runs();
+        }
         let before = self.tripped;
         let arch = self.arch;
         arch.dispatch(LaneBlock {
@@ -347,13 +437,13 @@ impl LaneEngine {
             outputs,
             out_channels,
         });
-        self.scan_positions();
         std::array::from_fn(|l| self.tripped[l] && !before[l])
     }
 
     #[inline(always)]
-    fn run(
+    fn run<S: pulp::Simd>(
         &mut self,
+        o: Ops<S>,
         frames: usize,
         inputs: &[f64],
         in_channels: usize,
@@ -361,21 +451,36 @@ impl LaneEngine {
         out_channels: usize,
     ) {
         for n in 0..frames {
-            self.step(n, frames, inputs, in_channels);
+            self.step(o, n, frames, inputs, in_channels);
             self.write_outputs(n, frames, out_channels, outputs);
+            // Lanes whose flush is due flush below FLUSH_BELOW, the others below 0 (never).
+            let mut below = Lanes::ZERO;
+            let mut due = false;
             for l in 0..LANES {
                 self.samples_since_reset[l] += 1;
                 if self.samples_since_reset[l].is_multiple_of(FLUSH_INTERVAL) {
-                    self.flush_lane(l);
+                    below[l] = FLUSH_BELOW;
+                    due = true;
                 }
             }
+            if due {
+                self.flush(o, below);
+            }
         }
+        self.scan_positions(o);
     }
 
     /// One sample of every lane: stages 1 a, 2 a, 2 b, 3, 4 (interactions, then force inputs)
     /// and 5 of spec §1.5, in the plain engine's order.
     #[inline(always)]
-    fn step(&mut self, n: usize, frames: usize, inputs: &[f64], in_channels: usize) {
+    fn step<S: pulp::Simd>(
+        &mut self,
+        o: Ops<S>,
+        n: usize,
+        frames: usize,
+        inputs: &[f64],
+        in_channels: usize,
+    ) {
         // The input of channel `ch` for lane `l` (non-finite and missing channels read 0).
         let input = |ch: u32, l: usize| -> f64 {
             let ch = ch as usize;
@@ -412,95 +517,93 @@ impl LaneEngine {
             &self.gravity[..count],
             &self.inv_m[..count],
         );
-        for i in 0..count {
-            for l in 0..LANES {
-                let next =
-                    a[i][l] * x[i][l] + b[i][l] * xp[i][l] + (f[i][l] - g[i][l]) * inv_m[i][l];
-                xp[i][l] = x[i][l];
-                x[i][l] = next;
-                f[i][l] = 0.0;
+        for &(start, end, uniform) in &self.mass_runs[..self.mass_run_count] {
+            let (start, end) = (start as usize, end as usize);
+            if uniform {
+                let coefficients = (a[start], b[start], g[start], inv_m[start]);
+                for i in start..end {
+                    update_single(o, &mut x[i], &mut xp[i], &mut f[i], coefficients);
+                }
+            } else {
+                for i in start..end {
+                    let coefficients = (a[i], b[i], g[i], inv_m[i]);
+                    update_single(o, &mut x[i], &mut xp[i], &mut f[i], coefficients);
+                }
             }
         }
         // Stage 2 b: macros; stage 3: connection points.
         let macros = &self.template.macros;
         let (x, xp, f) = (&mut self.x[..], &mut self.xp[..], &mut self.f[..]);
-        let (v, s) = (&mut self.scratch_v[..], &mut self.scratch_s[..]);
+        let v = &mut self.scratch_v[..];
         for mac in &macros.lines {
-            structures::line_step(mac, false, x, xp, f, s, &self.args);
+            structures::line_step(o, mac, false, x, xp, f, &self.args);
         }
         for mac in &macros.stiff {
-            structures::line_step(mac, true, x, xp, f, s, &self.args);
+            structures::line_step(o, mac, true, x, xp, f, &self.args);
         }
         for mac in &macros.meshes {
-            structures::mesh_step(mac, x, xp, f, v, s, &self.args);
+            structures::mesh_step(o, mac, x, xp, f, v, &self.args);
         }
-        structures::place_connection_points(&self.proxies, x, xp, f);
+        structures::place_connection_points(o, &self.proxies, x, xp, f);
         // Stage 4: the interactions, one loop per law, then the force inputs.
         let it = &self.template.interactions;
         let args = &self.args[..];
-        let (x, xp, f, chain) = (
-            &self.x[..],
-            &self.xp[..],
-            &mut self.f[..],
-            &mut self.chain[..],
-        );
+        let (x, xp, f) = (&self.x[..], &self.xp[..], &mut self.f[..]);
         // A group's argument column c, sliced to the group's length.
         let col = |g: &Group, c: usize| &args[g.cols[c]..g.cols[c] + g.len()];
         let g = &it.linear;
         if g.len() > 0 {
             let (k, z) = (col(g, 0), col(g, 1));
-            apply(g, x, xp, f, chain, |i, l, dx, dv| {
-                laws::spring_damper(dx, dv, k[i][l], z[i][l])
-            });
+            apply(o, g, x, xp, f, &Linear { k, z });
         }
         let g = &it.contact;
         if g.len() > 0 {
             let (k, z, t) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, chain, |i, l, dx, dv| {
-                laws::contact(dx, dv, k[i][l], z[i][l], t[i][l])
-            });
+            let law = |i: usize, l: usize, dx, dv| laws::contact(dx, dv, k[i][l], z[i][l], t[i][l]);
+            apply(o, g, x, xp, f, &PerLane(law));
         }
         let g = &it.nl_contact;
         if g.len() > 0 {
             let (s, c, k, z, t) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3), col(g, 4));
-            apply(g, x, xp, f, chain, |i, l, dx, dv| {
+            let law = |i: usize, l: usize, dx, dv| {
                 laws::nl_contact(dx, dv, s[i][l], c[i][l], k[i][l], z[i][l], t[i][l])
-            });
+            };
+            apply(o, g, x, xp, f, &PerLane(law));
         }
         let g = &it.nl_spring2;
         if g.len() > 0 {
             let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, chain, |i, l, dx, dv| {
-                laws::nl_spring2(dx, dv, k[i][l], q[i][l], z[i][l])
-            });
+            let law =
+                |i: usize, l: usize, dx, dv| laws::nl_spring2(dx, dv, k[i][l], q[i][l], z[i][l]);
+            apply(o, g, x, xp, f, &PerLane(law));
         }
         let g = &it.nl_spring3;
         if g.len() > 0 {
             let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, chain, |i, l, dx, dv| {
-                laws::nl_spring3(dx, dv, k[i][l], q[i][l], z[i][l])
-            });
+            let law =
+                |i: usize, l: usize, dx, dv| laws::nl_spring3(dx, dv, k[i][l], q[i][l], z[i][l]);
+            apply(o, g, x, xp, f, &PerLane(law));
         }
         let g = &it.nl_spring_damper;
         if g.len() > 0 {
             let (s, c, k, z) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3));
-            apply(g, x, xp, f, chain, |i, l, dx, dv| {
+            let law = |i: usize, l: usize, dx, dv| {
                 laws::nl_spring_damper(dx, dv, s[i][l], c[i][l], k[i][l], z[i][l])
-            });
+            };
+            apply(o, g, x, xp, f, &PerLane(law));
         }
         let g = &it.pluck;
         if g.len() > 0 {
             let (k, sc, z) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, chain, |i, l, dx, dv| {
-                laws::nl_pluck(dx, dv, k[i][l], sc[i][l], z[i][l])
-            });
+            let law =
+                |i: usize, l: usize, dx, dv| laws::nl_pluck(dx, dv, k[i][l], sc[i][l], z[i][l]);
+            apply(o, g, x, xp, f, &PerLane(law));
         }
         let g = &it.bow;
         if g.len() > 0 {
             let (z, sc, sm) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(g, x, xp, f, chain, |i, l, _dx, dv| {
-                laws::nl_bow(dv, z[i][l], sc[i][l], sm[i][l])
-            });
+            let law = |i: usize, l: usize, _dx, dv| laws::nl_bow(dv, z[i][l], sc[i][l], sm[i][l]);
+            apply(o, g, x, xp, f, &PerLane(law));
         }
         for r in &self.template.force_inputs {
             // A silent or missing channel adds 0, as the plain engine does (−0 + 0 = +0).
@@ -510,7 +613,7 @@ impl LaneEngine {
             }
         }
         // Stage 5: connection-point forces onto the macro nodes.
-        structures::spread_connection_forces(&self.proxies, f);
+        structures::spread_connection_forces(o, &self.proxies, f);
     }
 
     /// Stage 6: frame `n` of every output of every lane; a lane whose output is non-finite
@@ -539,8 +642,7 @@ impl LaneEngine {
         }
         for &(channel, start, len) in &t.frc_outputs {
             let sources = &t.frc_sources[start as usize..(start + len) as usize];
-            let total: Lanes =
-                std::array::from_fn(|l| sources.iter().map(|&p| self.f[p as usize][l]).sum());
+            let total = per_lane(|l| sources.iter().map(|&p| self.f[p as usize][l]).sum());
             put(channel, total, &mut tripped);
         }
         if tripped != self.tripped {
@@ -557,112 +659,62 @@ impl LaneEngine {
         }
     }
 
-    /// [`Engine`]'s flush below [`FLUSH_BELOW`], for one lane.
-    fn flush_lane(&mut self, l: usize) {
+    /// [`Engine`]'s flush: every position, delayed position and pending force smaller than
+    /// `below` in its lane becomes 0 (`below` is [`FLUSH_BELOW`] in the lanes due, 0 in the
+    /// others).
+    #[inline(always)]
+    fn flush<S: pulp::Simd>(&mut self, o: Ops<S>, below: Lanes) {
         for v in self
             .x
             .iter_mut()
             .chain(self.xp.iter_mut())
             .chain(self.f.iter_mut())
         {
-            v[l] = if v[l].abs() < FLUSH_BELOW { 0.0 } else { v[l] };
+            *v = o.zero_below(*v, below);
         }
     }
 
-    /// Checks every position of every lane at the end of a block.
-    fn scan_positions(&mut self) {
+    /// Checks every position of every lane at the end of a block: a lane with one beyond the
+    /// position limit, or not a number, trips.
+    #[inline(always)]
+    fn scan_positions<S: pulp::Simd>(&mut self, o: Ops<S>) {
         let limit = self.template.position_limit;
+        let mut beyond = Lanes::ZERO;
         for x in &self.x {
-            for l in 0..LANES {
-                if !(x[l].abs() <= limit) {
-                    self.tripped[l] = true;
-                }
+            beyond = o.flag_beyond(*x, limit, beyond);
+        }
+        for l in 0..LANES {
+            if beyond[l] != 0.0 {
+                self.tripped[l] = true;
             }
         }
     }
 }
 
-/// `law(i, lane, Δx, Δv)` on every pair of a group and every lane, with the convention of
-/// spec §1.3: F₁ −= f, F₂ += f, link by link; a band as `Group::apply` runs it (its forces,
-/// then every point's sum: the same arithmetic), with `scratch` for its forces.
+/// Stage 2 a for one single in every lane: X[n+1] = a·X + b·X̃ + (F − g)·(1/M) (spec
+/// §2.1.2), then X̃ ← X, X ← X[n+1], F ← 0.
 #[inline(always)]
-fn apply(
-    g: &Group,
-    x: &[Lanes],
-    xp: &[Lanes],
-    f: &mut [Lanes],
-    scratch: &mut [Lanes],
-    law: impl Fn(usize, usize, f64, f64) -> f64,
+fn update_single<S: pulp::Simd>(
+    o: Ops<S>,
+    x: &mut Lanes,
+    xp: &mut Lanes,
+    f: &mut Lanes,
+    (a, b, g, inv_m): (Lanes, Lanes, Lanes, Lanes),
 ) {
-    let n = g.len();
-    let (a, b) = (&g.a[..n], &g.b[..n]);
-    let mut i = 0;
-    let mut c = 0;
-    loop {
-        if g.reversed.get(c).copied().unwrap_or(false) {
-            // Reversed chains scatter here, with the links before the next chain.
-            c += 1;
-            continue;
-        }
-        let (next, m, d) = match g.chains.get(c) {
-            Some(&(start, len, d)) => (start as usize, len as usize, d as usize),
-            None => (n, 0, 0),
-        };
-        for k in i..next {
-            let (ia, ib) = (a[k] as usize, b[k] as usize);
-            let (xa, xb, xpa, xpb) = (x[ia], x[ib], xp[ia], xp[ib]);
-            let force: Lanes = std::array::from_fn(|l| {
-                let dx = xa[l] - xb[l];
-                let dv = (xa[l] - xpa[l]) - (xb[l] - xpb[l]);
-                law(k, l, dx, dv)
-            });
-            for l in 0..LANES {
-                f[ia][l] -= force[l];
-            }
-            for l in 0..LANES {
-                f[ib][l] += force[l];
-            }
-        }
-        if m == 0 {
-            break;
-        }
-        let q = a[next] as usize;
-        let s = &mut scratch[..m];
-        for j in 0..m {
-            let (xa, xb, xpa, xpb) = (x[q + j], x[q + d + j], xp[q + j], xp[q + d + j]);
-            s[j] = std::array::from_fn(|l| {
-                let dx = xa[l] - xb[l];
-                let dv = (xa[l] - xpa[l]) - (xb[l] - xpb[l]);
-                law(next + j, l, dx, dv)
-            });
-        }
-        let fs = &mut f[q..q + m + d];
-        for t in 0..m.min(d) {
-            for l in 0..LANES {
-                fs[t][l] -= s[t][l];
-            }
-        }
-        for t in d..m {
-            for l in 0..LANES {
-                fs[t][l] = (fs[t][l] + s[t - d][l]) - s[t][l];
-            }
-        }
-        for t in m.max(d)..m + d {
-            for l in 0..LANES {
-                fs[t][l] += s[t - d][l];
-            }
-        }
-        i = next + m;
-        c += 1;
-    }
+    let next = o.add(
+        o.add(o.mul(a, *x), o.mul(b, *xp)),
+        o.mul(o.sub(*f, g), inv_m),
+    );
+    *xp = *x;
+    *x = next;
+    *f = Lanes::ZERO;
 }
 
-/// The instruction set lanes run with: AVX2 where the CPU has it, even when it has AVX-512.
-/// A lane group is four f64, one AVX2 register; with AVX-512 the same loops measured 4 %
-/// slower (1000 Drunk Triangles voices, 17.1 against 17.9 µs per sample). The same IEEE
-/// operations either way, so the same samples.
+/// The instruction set lanes run with: the best the CPU has (pulp's runtime detection), so a
+/// group's [`Lanes`] is one AVX-512 register, two AVX2 ones, or eight scalars. The same IEEE
+/// operations on every path (no fused multiply-add), so the same samples.
 fn lane_arch() -> pulp::Arch {
-    crate::kernels::avx2().unwrap_or_default()
+    pulp::Arch::new()
 }
 
 /// One block of [`LaneEngine::process`] as a pulp operation (see `Engine::process`).
@@ -679,8 +731,9 @@ impl pulp::WithSimd for LaneBlock<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
         self.lanes.run(
+            Ops(simd),
             self.frames,
             self.inputs,
             self.in_channels,

@@ -4,19 +4,15 @@
 //! schedule, `kernels::proxies`) in their order, so each lane equals a plain engine bit for bit
 //! (engine test `lanes`).
 
-use super::Lanes;
+use super::vector::{self, Ops};
+use super::{Lanes, LANES};
 use crate::engine::{node_law, LineMacro, MeshMacro, Proxies};
-use crate::laws;
 
 /// Per-lane node law coefficients (a, b, 1/M) of a macro from its M and Zo slots.
 #[inline(always)]
 fn lane_node_law(args: &[Lanes], m: usize, zo: usize) -> (Lanes, Lanes, Lanes) {
-    let mut out = (
-        [0.0; super::LANES],
-        [0.0; super::LANES],
-        [0.0; super::LANES],
-    );
-    for l in 0..super::LANES {
+    let mut out = (Lanes::ZERO, Lanes::ZERO, Lanes::ZERO);
+    for l in 0..LANES {
         let (a, b, inv_m) = node_law(args[m][l], args[zo][l]);
         out.0[l] = a;
         out.1[l] = b;
@@ -28,32 +24,33 @@ fn lane_node_law(args: &[Lanes], m: usize, zo: usize) -> (Lanes, Lanes, Lanes) {
 /// Node law of a macro's moving nodes `nodes` (`kernels::macros::node_law`): X[n+1] =
 /// a·X + b·X̃ + F·(1/M), per lane.
 #[inline(always)]
-fn update_nodes(
+fn update_nodes<S: pulp::Simd>(
+    o: Ops<S>,
     (a, b, inv_m): (Lanes, Lanes, Lanes),
     x: &mut [Lanes],
     xp: &mut [Lanes],
     f: &[Lanes],
     nodes: std::ops::Range<usize>,
 ) {
-    for i in nodes {
-        for l in 0..super::LANES {
-            let next = a[l] * x[i][l] + b[l] * xp[i][l] + f[i][l] * inv_m[l];
-            xp[i][l] = x[i][l];
-            x[i][l] = next;
-        }
+    let (x, xp, f) = (&mut x[nodes.clone()], &mut xp[nodes.clone()], &f[nodes]);
+    for ((x, xp), f) in x.iter_mut().zip(xp.iter_mut()).zip(f) {
+        let next = o.add(o.add(o.mul(a, *x), o.mul(b, *xp)), o.mul(*f, inv_m));
+        *xp = *x;
+        *x = next;
     }
 }
 
 /// A string, chain or stiff string (`kernels::macros`: `update_line_nodes`, `chain_links`,
-/// then for a stiff string `stiffness_links`).
+/// then for a stiff string `stiffness_links`). The chain's forces are assigned, F₀ = −s₀,
+/// Fᵢ = sᵢ₋₁ − sᵢ, F_{n−1} = s_{n−2}, each node's position and velocity read once.
 #[inline(always)]
-pub(super) fn line_step(
+pub(super) fn line_step<S: pulp::Simd>(
+    o: Ops<S>,
     mac: &LineMacro,
     stiff: bool,
     x: &mut [Lanes],
     xp: &mut [Lanes],
     f: &mut [Lanes],
-    s: &mut [Lanes],
     args: &[Lanes],
 ) {
     let law = lane_node_law(args, mac.slots.m, mac.slots.zo);
@@ -68,29 +65,21 @@ pub(super) fn line_step(
     } else {
         (0, n)
     };
-    update_nodes(law, x, xp, f, lo..hi);
+    update_nodes(o, law, x, xp, f, lo..hi);
     if n < 2 {
-        f.fill([0.0; super::LANES]);
+        f.fill(Lanes::ZERO);
     } else {
         let (k, z) = (args[mac.slots.k], args[mac.slots.z]);
-        let s = &mut s[..n - 1];
+        let (mut xa, mut va) = (x[0], o.sub(x[0], xp[0]));
+        let mut before = Lanes::ZERO;
         for i in 0..n - 1 {
-            for l in 0..super::LANES {
-                let dv = (x[i][l] - xp[i][l]) - (x[i + 1][l] - xp[i + 1][l]);
-                s[i][l] = laws::spring_damper(x[i][l] - x[i + 1][l], dv, k[l], z[l]);
-            }
+            let xb = x[i + 1];
+            let vb = o.sub(xb, xp[i + 1]);
+            let s = vector::spring_damper(o, o.sub(xa, xb), o.sub(va, vb), k, z);
+            f[i] = if i == 0 { o.neg(s) } else { o.sub(before, s) };
+            (xa, va, before) = (xb, vb, s);
         }
-        for l in 0..super::LANES {
-            f[0][l] = -s[0][l];
-        }
-        for i in 1..n - 1 {
-            for l in 0..super::LANES {
-                f[i][l] = s[i - 1][l] - s[i][l];
-            }
-        }
-        for l in 0..super::LANES {
-            f[n - 1][l] = s[n - 2][l];
-        }
+        f[n - 1] = before;
     }
     if stiff {
         let k2 = args[mac.slots.k2];
@@ -98,24 +87,22 @@ pub(super) fn line_step(
         for i in -1..n {
             let p = i.clamp(0, n - 1) as usize;
             let q = (i + 2).clamp(0, n - 1) as usize;
-            for l in 0..super::LANES {
-                let t = k2[l] * (x[p][l] - x[q][l]);
-                f[p][l] -= t;
-                f[q][l] += t;
-            }
+            let t = o.mul(k2, o.sub(x[p], x[q]));
+            f[p] = o.sub(f[p], t);
+            f[q] = o.add(f[q], t);
         }
     }
 }
 
 /// A mesh, pass by pass (`kernels::mesh::mesh_step_passes`).
 #[inline(always)]
-pub(super) fn mesh_step(
+pub(super) fn mesh_step<S: pulp::Simd>(
+    o: Ops<S>,
     mac: &MeshMacro,
     x: &mut [Lanes],
     xp: &mut [Lanes],
     f: &mut [Lanes],
     v: &mut [Lanes],
-    s: &mut [Lanes],
     args: &[Lanes],
 ) {
     let law = lane_node_law(args, mac.slots.m, mac.slots.zo);
@@ -128,67 +115,52 @@ pub(super) fn mesh_step(
         &mut f[mac.base..mac.base + n],
     );
     let x_edge = x[0];
-    update_nodes(law, x, xp, f, 0..n);
+    update_nodes(o, law, x, xp, f, 0..n);
     for &p in &mac.pinned {
         x[p as usize] = x_edge;
         xp[p as usize] = x_edge;
     }
     let v = &mut v[..n];
-    for i in 0..n {
-        for l in 0..super::LANES {
-            v[i][l] = x[i][l] - xp[i][l];
-        }
+    for ((v, x), xp) in v.iter_mut().zip(&*x).zip(&*xp) {
+        *v = o.sub(*x, *xp);
     }
-    let sd = |p: usize, q: usize, l: usize| {
-        laws::spring_damper(x[p][l] - x[q][l], v[p][l] - v[q][l], k[l], z[l])
-    };
-    // Links along the width, row by row: each row's forces assigned (F is consumed).
-    let sr = &mut s[..w - 1];
+    // A function, not a closure: a closure does not inherit the instruction set, so its
+    // vector operations would not inline.
+    #[inline(always)]
+    fn link<S: pulp::Simd>(
+        o: Ops<S>,
+        x: &[Lanes],
+        v: &[Lanes],
+        p: usize,
+        q: usize,
+        (k, z): (Lanes, Lanes),
+    ) -> Lanes {
+        vector::spring_damper(o, o.sub(x[p], x[q]), o.sub(v[p], v[q]), k, z)
+    }
+    // Links along the width, row by row: each row's forces assigned (F is consumed), F_r =
+    // −s₀, then s_{j−1} − s_j, the row's last node s_{w−2}.
     for row in 0..len {
         let r = row * w;
+        let mut before = Lanes::ZERO;
         for j in 0..w - 1 {
-            for l in 0..super::LANES {
-                sr[j][l] = sd(r + j, r + j + 1, l);
-            }
+            let s = link(o, x, v, r + j, r + j + 1, (k, z));
+            f[r + j] = if j == 0 { o.neg(s) } else { o.sub(before, s) };
+            before = s;
         }
-        for l in 0..super::LANES {
-            f[r][l] = -sr[0][l];
-            f[r + w - 1][l] = sr[w - 2][l];
-        }
-        for j in 1..w - 1 {
-            for l in 0..super::LANES {
-                f[r + j][l] = sr[j - 1][l] - sr[j][l];
-            }
-        }
+        f[r + w - 1] = before;
     }
-    // Links along the length, (i, i + W): node i receives +s[i − W] before −s[i].
-    let m = (len - 1) * w;
-    let s = &mut s[..m];
-    for i in 0..m {
-        for l in 0..super::LANES {
-            s[i][l] = sd(i, i + w, l);
-        }
-    }
-    for i in 0..w.min(m) {
-        for l in 0..super::LANES {
-            f[i][l] -= s[i][l];
-        }
-    }
-    for i in w..m {
-        for l in 0..super::LANES {
-            f[i][l] = f[i][l] + s[i - w][l] - s[i][l];
-        }
-    }
-    for i in m.max(w)..n {
-        for l in 0..super::LANES {
-            f[i][l] += s[i - w][l];
-        }
+    // Links along the length, (i, i + W), in order: node i receives +s[i − W] before −s[i].
+    for i in 0..(len - 1) * w {
+        let s = link(o, x, v, i, i + w, (k, z));
+        f[i] = o.sub(f[i], s);
+        f[i + w] = o.add(f[i + w], s);
     }
 }
 
 /// Stage 3 (`Proxies::update_positions`): x̃_P ← x_P, x_P ← Σ w·x_node, F_P ← 0.
 #[inline(always)]
-pub(super) fn place_connection_points(
+pub(super) fn place_connection_points<S: pulp::Simd>(
+    o: Ops<S>,
     proxies: &Proxies,
     x: &mut [Lanes],
     xp: &mut [Lanes],
@@ -196,26 +168,30 @@ pub(super) fn place_connection_points(
 ) {
     for i in 0..proxies.len() {
         let [n0, n1, n2, n3] = proxies.nodes[i].map(|n| n as usize);
-        let [w0, w1, w2, w3] = proxies.weights[i];
+        let [w0, w1, w2, w3] = proxies.weights[i].map(Lanes::splat);
         let k = proxies.base + i;
-        for l in 0..super::LANES {
-            let pos = w0 * x[n0][l] + w1 * x[n1][l] + w2 * x[n2][l] + w3 * x[n3][l];
-            xp[k][l] = x[k][l];
-            x[k][l] = pos;
-            f[k][l] = 0.0;
-        }
+        let pos = o.add(
+            o.add(o.add(o.mul(w0, x[n0]), o.mul(w1, x[n1])), o.mul(w2, x[n2])),
+            o.mul(w3, x[n3]),
+        );
+        xp[k] = x[k];
+        x[k] = pos;
+        f[k] = Lanes::ZERO;
     }
 }
 
 /// Stage 5 (`Proxies::spread_forces`): F_P onto the macro nodes, in creation order.
 #[inline(always)]
-pub(super) fn spread_connection_forces(proxies: &Proxies, f: &mut [Lanes]) {
+pub(super) fn spread_connection_forces<S: pulp::Simd>(
+    o: Ops<S>,
+    proxies: &Proxies,
+    f: &mut [Lanes],
+) {
     for i in 0..proxies.len() {
         let fp = f[proxies.base + i];
         for (n, w) in proxies.nodes[i].iter().zip(proxies.weights[i]) {
-            for l in 0..super::LANES {
-                f[*n as usize][l] += w * fp[l];
-            }
+            let n = *n as usize;
+            f[n] = o.add(f[n], o.mul(Lanes::splat(w), fp));
         }
     }
 }
