@@ -22,8 +22,10 @@ use crate::{Engine, ParamError, ParamId};
 mod links;
 mod structures;
 mod vector;
+mod vector_laws;
 
-use links::{apply, per_lane, Linear, PerLane};
+use links::{apply, Linear, PerLane};
+use links::{Contact, NlContact, NlSpring2, NlSpring3, NlSpringDamper, Pluck};
 use vector::Ops;
 
 /// Voices per lane group.
@@ -452,7 +454,7 @@ impl LaneEngine {
     ) {
         for n in 0..frames {
             self.step(o, n, frames, inputs, in_channels);
-            self.write_outputs(n, frames, out_channels, outputs);
+            self.write_outputs(o, n, frames, out_channels, outputs);
             // Lanes whose flush is due flush below FLUSH_BELOW, the others below 0 (never).
             let mut below = Lanes::ZERO;
             let mut due = false;
@@ -559,45 +561,32 @@ impl LaneEngine {
         let g = &it.contact;
         if g.len() > 0 {
             let (k, z, t) = (col(g, 0), col(g, 1), col(g, 2));
-            let law = |i: usize, l: usize, dx, dv| laws::contact(dx, dv, k[i][l], z[i][l], t[i][l]);
-            apply(o, g, x, xp, f, &PerLane(law));
+            apply(o, g, x, xp, f, &Contact { k, z, t });
         }
         let g = &it.nl_contact;
         if g.len() > 0 {
             let (s, c, k, z, t) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3), col(g, 4));
-            let law = |i: usize, l: usize, dx, dv| {
-                laws::nl_contact(dx, dv, s[i][l], c[i][l], k[i][l], z[i][l], t[i][l])
-            };
-            apply(o, g, x, xp, f, &PerLane(law));
+            apply(o, g, x, xp, f, &NlContact { s, c, k, z, t });
         }
         let g = &it.nl_spring2;
         if g.len() > 0 {
             let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
-            let law =
-                |i: usize, l: usize, dx, dv| laws::nl_spring2(dx, dv, k[i][l], q[i][l], z[i][l]);
-            apply(o, g, x, xp, f, &PerLane(law));
+            apply(o, g, x, xp, f, &NlSpring2 { k, q, z });
         }
         let g = &it.nl_spring3;
         if g.len() > 0 {
             let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
-            let law =
-                |i: usize, l: usize, dx, dv| laws::nl_spring3(dx, dv, k[i][l], q[i][l], z[i][l]);
-            apply(o, g, x, xp, f, &PerLane(law));
+            apply(o, g, x, xp, f, &NlSpring3 { k, q, z });
         }
         let g = &it.nl_spring_damper;
         if g.len() > 0 {
             let (s, c, k, z) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3));
-            let law = |i: usize, l: usize, dx, dv| {
-                laws::nl_spring_damper(dx, dv, s[i][l], c[i][l], k[i][l], z[i][l])
-            };
-            apply(o, g, x, xp, f, &PerLane(law));
+            apply(o, g, x, xp, f, &NlSpringDamper { s, c, k, z });
         }
         let g = &it.pluck;
         if g.len() > 0 {
-            let (k, sc, z) = (col(g, 0), col(g, 1), col(g, 2));
-            let law =
-                |i: usize, l: usize, dx, dv| laws::nl_pluck(dx, dv, k[i][l], sc[i][l], z[i][l]);
-            apply(o, g, x, xp, f, &PerLane(law));
+            let (k, scale, z) = (col(g, 0), col(g, 1), col(g, 2));
+            apply(o, g, x, xp, f, &Pluck { k, scale, z });
         }
         let g = &it.bow;
         if g.len() > 0 {
@@ -617,45 +606,54 @@ impl LaneEngine {
     }
 
     /// Stage 6: frame `n` of every output of every lane; a lane whose output is non-finite
-    /// or beyond the position limit trips (its outputs are 0 from this sample on).
+    /// or beyond the position limit trips (its outputs are 0 from this sample on, on every
+    /// channel of this frame, as the plain engine clears them).
     #[inline(always)]
-    fn write_outputs(&mut self, n: usize, frames: usize, out_channels: usize, outputs: &mut [f64]) {
+    fn write_outputs<S: pulp::Simd>(
+        &mut self,
+        o: Ops<S>,
+        n: usize,
+        frames: usize,
+        out_channels: usize,
+        outputs: &mut [f64],
+    ) {
         let limit = self.template.position_limit;
         let t = &self.template;
-        let mut put = |channel: u32, v: Lanes, tripped: &mut [bool; LANES]| {
+        // Copies only: the checks stay out of this closure, which is compiled on its own.
+        let mut put = |channel: u32, v: &Lanes| {
             let ch = channel as usize;
-            for l in 0..LANES {
-                if !(v[l].is_finite() && v[l].abs() <= limit) {
-                    tripped[l] = true;
-                }
-            }
             if ch < out_channels {
                 let at = (ch * frames + n) * LANES;
-                for l in 0..LANES {
-                    outputs[at + l] = if tripped[l] { 0.0 } else { v[l] };
-                }
+                outputs[at..at + LANES].copy_from_slice(&v.0);
             }
         };
-        let mut tripped = self.tripped;
+        let mut beyond = Lanes::ZERO;
         for r in &t.pos_outputs {
-            put(r.channel, self.x[r.index as usize], &mut tripped);
+            let v = self.x[r.index as usize];
+            beyond = o.flag_beyond(v, limit, beyond);
+            put(r.channel, &v);
         }
         for &(channel, start, len) in &t.frc_outputs {
             let sources = &t.frc_sources[start as usize..(start + len) as usize];
-            let total = per_lane(|l| sources.iter().map(|&p| self.f[p as usize][l]).sum());
-            put(channel, total, &mut tripped);
+            // Σ F as `Iterator::sum` forms it: −0 + F₁ = F₁ bit for bit, then in order.
+            let mut total = Lanes::splat(-0.0);
+            for &p in sources {
+                total = o.add(total, self.f[p as usize]);
+            }
+            beyond = o.flag_beyond(total, limit, beyond);
+            put(channel, &total);
         }
-        if tripped != self.tripped {
-            // An output that tripped a lane on this sample was written before the check of a
-            // later channel: clear the lane's frame on every channel, as the plain engine does.
-            for l in 0..LANES {
-                if tripped[l] && !self.tripped[l] {
-                    for ch in 0..out_channels {
-                        outputs[(ch * frames + n) * LANES + l] = 0.0;
-                    }
+        for l in 0..LANES {
+            if beyond[l] != 0.0 {
+                self.tripped[l] = true;
+            }
+        }
+        if self.tripped.iter().any(|&t| t) {
+            for l in (0..LANES).filter(|&l| self.tripped[l]) {
+                for ch in 0..out_channels {
+                    outputs[(ch * frames + n) * LANES + l] = 0.0;
                 }
             }
-            self.tripped = tripped;
         }
     }
 
@@ -701,11 +699,12 @@ fn update_single<S: pulp::Simd>(
     f: &mut Lanes,
     (a, b, g, inv_m): (Lanes, Lanes, Lanes, Lanes),
 ) {
+    let (now, before, force) = (*x, *xp, *f);
     let next = o.add(
-        o.add(o.mul(a, *x), o.mul(b, *xp)),
-        o.mul(o.sub(*f, g), inv_m),
+        o.add(o.mul(a, now), o.mul(b, before)),
+        o.mul(o.sub(force, g), inv_m),
     );
-    *xp = *x;
+    *xp = now;
     *x = next;
     *f = Lanes::ZERO;
 }

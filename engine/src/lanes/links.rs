@@ -3,6 +3,7 @@
 //! a plain engine bit for bit (engine test `lanes`).
 
 use super::vector::{self, Ops};
+use super::vector_laws;
 use super::Lanes;
 use crate::engine::Group;
 
@@ -15,8 +16,14 @@ pub(super) fn per_lane(law: impl Fn(usize) -> f64) -> Lanes {
 /// A link law in every lane: the force of a group's link `i` from the deltas of every lane.
 /// A trait with inlined methods rather than a closure: a closure is compiled without the
 /// instruction set of the loop that calls it, and its vector operations would not inline.
+/// The arguments are read apart from the force, so that a uniform band reads them once.
 pub(super) trait LaneLaw {
-    fn force<S: pulp::Simd>(&self, o: Ops<S>, i: usize, dx: Lanes, dv: Lanes) -> Lanes;
+    /// A link's arguments, as the law reads them.
+    type Args: Copy;
+    /// Link `i`'s arguments.
+    fn args(&self, i: usize) -> Self::Args;
+    /// The force for `args` and the deltas of every lane.
+    fn force<S: pulp::Simd>(&self, o: Ops<S>, args: Self::Args, dx: Lanes, dv: Lanes) -> Lanes;
 }
 
 /// `spring`, `damper`, `springDamper`: f = K·Δx + Z·Δv, in vectors (`laws::spring_damper`).
@@ -26,16 +33,72 @@ pub(super) struct Linear<'a> {
 }
 
 impl LaneLaw for Linear<'_> {
+    type Args = (Lanes, Lanes);
     #[inline(always)]
-    fn force<S: pulp::Simd>(&self, o: Ops<S>, i: usize, dx: Lanes, dv: Lanes) -> Lanes {
-        vector::spring_damper(o, dx, dv, self.k[i], self.z[i])
+    fn args(&self, i: usize) -> (Lanes, Lanes) {
+        (self.k[i], self.z[i])
+    }
+    #[inline(always)]
+    fn force<S: pulp::Simd>(
+        &self,
+        o: Ops<S>,
+        (k, z): (Lanes, Lanes),
+        dx: Lanes,
+        dv: Lanes,
+    ) -> Lanes {
+        vector::spring_damper(o, dx, dv, k, z)
     }
 }
 
-/// A nonlinear law, lane by lane: `law(i, lane, Δx, Δv)`.
+/// Link laws in vectors (`vector_laws`): a struct of the group's argument columns per law.
+macro_rules! vector_links {
+    ($($(#[$doc:meta])* $name:ident => $law:ident($($arg:ident),*);)*) => {$(
+        $(#[$doc])*
+        pub(super) struct $name<'a> {
+            $(pub $arg: &'a [Lanes],)*
+        }
+
+        impl LaneLaw for $name<'_> {
+            type Args = ($(vector_links!(@lanes $arg),)*);
+            #[inline(always)]
+            fn args(&self, i: usize) -> Self::Args {
+                ($(self.$arg[i],)*)
+            }
+            #[inline(always)]
+            fn force<S: pulp::Simd>(&self, o: Ops<S>, args: Self::Args, dx: Lanes, dv: Lanes) -> Lanes {
+                let ($($arg,)*) = args;
+                vector_laws::$law(o, dx, dv $(, $arg)*)
+            }
+        }
+    )*};
+    (@lanes $arg:ident) => { Lanes };
+}
+
+vector_links! {
+    /// `contact` (spec §2.4.1).
+    Contact => contact(k, z, t);
+    /// `nlContact` (spec §2.4.2).
+    NlContact => nl_contact(s, c, k, z, t);
+    /// `nlSpring2` (spec §2.5.1).
+    NlSpring2 => nl_spring2(k, q, z);
+    /// `nlSpring3` (spec §2.5.2).
+    NlSpring3 => nl_spring3(k, q, z);
+    /// `nlSpringDamper` (spec §2.5.3).
+    NlSpringDamper => nl_spring_damper(s, c, k, z);
+    /// `nlPluck` (spec §2.6.1).
+    Pluck => nl_pluck(k, scale, z);
+}
+
+/// A nonlinear law, lane by lane: `law(i, lane, Δx, Δv)` (`nlBow`).
 pub(super) struct PerLane<F>(pub F);
 
 impl<F: Fn(usize, usize, f64, f64) -> f64> LaneLaw for PerLane<F> {
+    /// The link's index: the closure reads its arguments.
+    type Args = usize;
+    #[inline(always)]
+    fn args(&self, i: usize) -> usize {
+        i
+    }
     #[inline(always)]
     fn force<S: pulp::Simd>(&self, _o: Ops<S>, i: usize, dx: Lanes, dv: Lanes) -> Lanes {
         per_lane(|l| (self.0)(i, l, dx[l], dv[l]))
@@ -71,7 +134,7 @@ pub(super) fn apply<S: pulp::Simd>(
         for k in i..next {
             let (ia, ib) = (a[k] as usize, b[k] as usize);
             let (dx, dv) = vector::deltas(o, x[ia], x[ib], xp[ia], xp[ib]);
-            let force = law.force(o, k, dx, dv);
+            let force = law.force(o, law.args(k), dx, dv);
             f[ia] = o.sub(f[ia], force);
             f[ib] = o.add(f[ib], force);
         }
@@ -88,15 +151,11 @@ pub(super) fn apply<S: pulp::Simd>(
         match (d, uniform) {
             (1, true) => chain::<S, true>(o, x, xp, f, law, next),
             (1, false) => chain::<S, false>(o, x, xp, f, law, next),
-            _ => {
-                let step = usize::from(!uniform);
-                for j in 0..m {
-                    let (dx, dv) = vector::deltas(o, x[j], x[j + d], xp[j], xp[j + d]);
-                    let force = law.force(o, next + j * step, dx, dv);
-                    f[j] = o.sub(f[j], force);
-                    f[j + d] = o.add(f[j + d], force);
-                }
+            (_, true) => {
+                let args = law.args(next);
+                band(o, x, xp, f, d, |_| args, law)
             }
+            (_, false) => band(o, x, xp, f, d, |j| law.args(next + j), law),
         }
         i = next + m;
         c += 1;
@@ -119,15 +178,42 @@ fn chain<S: pulp::Simd, const UNIFORM: bool>(
     let m = x.len() - 1;
     let (xp, f) = (&xp[..=m], &mut f[..=m]);
     let (mut xa, mut va, mut fa) = (x[0], o.sub(x[0], xp[0]), f[0]);
+    let uniform = law.args(first);
     for j in 0..m {
         let xb = x[j + 1];
         let vb = o.sub(xb, xp[j + 1]);
         // Δx and Δv as `vector::deltas` forms them.
-        let link = if UNIFORM { first } else { first + j };
-        let force = law.force(o, link, o.sub(xa, xb), o.sub(va, vb));
+        let args = if UNIFORM {
+            uniform
+        } else {
+            law.args(first + j)
+        };
+        let force = law.force(o, args, o.sub(xa, xb), o.sub(va, vb));
         f[j] = o.sub(fa, force);
         fa = o.add(f[j + 1], force);
         (xa, va) = (xb, vb);
     }
     f[m] = fa;
+}
+
+/// A band of offset `d` over `x.len() − d` links, link j with the arguments `args(j)`, in
+/// `apply`'s order.
+#[inline(always)]
+fn band<S: pulp::Simd, L: LaneLaw>(
+    o: Ops<S>,
+    x: &[Lanes],
+    xp: &[Lanes],
+    f: &mut [Lanes],
+    d: usize,
+    args: impl Fn(usize) -> L::Args,
+    law: &L,
+) {
+    let m = x.len() - d;
+    let (xp, f) = (&xp[..m + d], &mut f[..m + d]);
+    for j in 0..m {
+        let (dx, dv) = vector::deltas(o, x[j], x[j + d], xp[j], xp[j + d]);
+        let force = law.force(o, args(j), dx, dv);
+        f[j] = o.sub(f[j], force);
+        f[j + d] = o.add(f[j + d], force);
+    }
 }
