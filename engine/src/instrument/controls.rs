@@ -140,11 +140,31 @@ impl Controlled for Engine {
     }
 }
 
-/// The inputs of one voice's gains ([`Smoothed::tune_key`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The smoothed controls a voice's gains read, bit for bit ([`Smoothed::controls_key`]).
+pub type ControlsKey = [u64; 3 + NUM_MACROS];
+
+/// The inputs of one voice's gains, bit for bit ([`TuneKey::new`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TuneKey {
-    smoothed: [f64; 3 + NUM_MACROS],
-    voice: [f64; 4],
+    smoothed: ControlsKey,
+    voice: [u64; 4],
+}
+
+impl TuneKey {
+    /// Everything [`Smoothed::gains_offset`] and [`Smoothed::set`] read for one voice: when
+    /// it has not changed since the voice was last tuned, neither have its gains.
+    pub fn new(
+        controls: &ControlsKey,
+        note_st: f64,
+        z_factor: f64,
+        k_octaves: f64,
+        z_octaves: f64,
+    ) -> TuneKey {
+        TuneKey {
+            smoothed: *controls,
+            voice: [note_st, z_factor, k_octaves, z_octaves].map(f64::to_bits),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Default)]
@@ -327,20 +347,17 @@ impl Smoothed {
         }
     }
 
-    /// Everything [`Smoothed::gains_offset`] and [`Smoothed::set`] read for one voice: when
-    /// it has not changed since the voice was last tuned, neither have its gains.
-    pub fn tune_key(&self, note_st: f64, z_factor: f64, k_octaves: f64, z_octaves: f64) -> TuneKey {
-        let mut smoothed = [0.0; 3 + NUM_MACROS];
-        smoothed[0] = self.stiffness.value;
-        smoothed[1] = self.damping.value;
-        smoothed[2] = self.tune.value;
-        for (k, m) in smoothed[3..].iter_mut().zip(&self.macros) {
-            *k = m.value;
+    /// The smoothed controls every voice's gains read, formed once per tuning pass over the
+    /// bank ([`TuneKey::new`]).
+    pub fn controls_key(&self) -> ControlsKey {
+        let mut key = [0; 3 + NUM_MACROS];
+        key[0] = self.stiffness.value.to_bits();
+        key[1] = self.damping.value.to_bits();
+        key[2] = self.tune.value.to_bits();
+        for (k, m) in key[3..].iter_mut().zip(&self.macros) {
+            *k = m.value.to_bits();
         }
-        TuneKey {
-            smoothed,
-            voice: [note_st, z_factor, k_octaves, z_octaves],
-        }
+        key
     }
 
     /// Puts `gains` and the macro values on one engine (the model's, or a voice's).

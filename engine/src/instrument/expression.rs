@@ -53,6 +53,7 @@ impl SharedGains {
 /// `shared` holds the gains of voices tuned before it with the same smoothed controls.
 pub(super) fn tune_voice(
     smoothed: &Smoothed,
+    controls: &ControlsKey,
     view: &ClampView<'_>,
     bank: &mut voices::VoiceBank,
     i: usize,
@@ -68,7 +69,7 @@ pub(super) fn tune_voice(
     let note_st = v.note_st + v.bend_st + v.tuning_st;
     // Every chunk re-tunes every voice; most of the time nothing moved (the exact law and
     // the clamp cost more than a small voice's 16 samples).
-    let key = smoothed.tune_key(note_st, z, v.mod_k, v.mod_z);
+    let key = TuneKey::new(controls, note_st, z, v.mod_k, v.mod_z);
     if let Some((k, g)) = v.tuned {
         if k == key {
             return g;
@@ -118,6 +119,7 @@ impl Instrument {
         self.shared_gains.clear();
         self.gains = tune_voice(
             &self.smoothed,
+            &self.smoothed.controls_key(),
             &view,
             bank,
             i,

@@ -41,7 +41,7 @@ pub use macros::MacroBinding;
 pub use prepare::{parse_script, peak_frequency, prepare, InputRole, Prepared, Rejected, Watcher};
 
 use crate::RouteSource;
-use controls::{ClampView, Smoothed};
+use controls::{ClampView, ControlsKey, Smoothed, TuneKey};
 use events::Modulated;
 use output::{OutputStage, Span};
 pub use voices::{Ended, VoiceBank, VoiceState};
@@ -328,12 +328,14 @@ impl Instrument {
         self.smoothed.set(&mut m.engine, view.macros, &shown);
         let mut newest = 0;
         self.shared_gains.clear();
+        let controls = self.smoothed.controls_key();
         for i in 0..bank.voices.len() {
             if bank.voices[i].state == VoiceState::Free {
                 continue;
             }
             let g = tune_voice(
                 &self.smoothed,
+                &controls,
                 &view,
                 bank,
                 i,

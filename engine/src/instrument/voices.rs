@@ -131,6 +131,9 @@ pub struct VoiceBank {
     /// [`LANES`] values per sample with lanes.
     inputs: Vec<f64>,
     outputs: Vec<f64>,
+    /// With lanes: the sounding voices' outputs summed lane by lane over the groups, laid out
+    /// as `outputs` (see `VoiceBank::process`).
+    mixed: Vec<f64>,
     /// A lane's positions and delayed positions, copied out.
     x: Vec<f64>,
     xp: Vec<f64>,
@@ -205,6 +208,7 @@ impl VoiceBank {
             copies,
             inputs: vec![0.0; n_in * CHUNK * width],
             outputs: vec![0.0; n_out.max(1) * CHUNK * width],
+            mixed: vec![0.0; n_out.max(1) * CHUNK * width],
             x: vec![0.0; points],
             xp: vec![0.0; points],
             limit,
@@ -523,6 +527,10 @@ impl VoiceBank {
                 }
             }
             Copies::Lanes(groups) => {
+                // The sounding voices' outputs add up lane by lane in `mixed` (one vector
+                // add per frame and group), then across the lanes into `outputs`.
+                let mixed = &mut self.mixed[..n_out * len * LANES];
+                mixed.fill(0.0);
                 for (g, group) in groups.iter_mut().enumerate() {
                     if !self.group_runs(g) {
                         continue;
@@ -547,6 +555,7 @@ impl VoiceBank {
                     }
                     let vout = &mut self.outputs[..n_out * len * LANES];
                     let lane_tripped = group.process(len, vin, vout);
+                    let mut sounding = [false; LANES];
                     for i in first..last {
                         if self.voices[i].state == VoiceState::Free {
                             continue;
@@ -557,8 +566,27 @@ impl VoiceBank {
                             self.end(i);
                             continue;
                         }
-                        self.mix(i, len, n_out, LANES, l, outputs);
+                        if self.voices[i].state == VoiceState::Fading {
+                            self.mix(i, len, n_out, LANES, l, outputs);
+                        } else {
+                            sounding[l] = true;
+                        }
                     }
+                    let mixed = &mut self.mixed[..n_out * len * LANES];
+                    let vout = &self.outputs[..n_out * len * LANES];
+                    for (sum, frame) in mixed.chunks_exact_mut(LANES).zip(vout.chunks_exact(LANES))
+                    {
+                        for l in 0..LANES {
+                            sum[l] += if sounding[l] { frame[l] } else { 0.0 };
+                        }
+                    }
+                }
+                let mixed = &self.mixed[..n_out * len * LANES];
+                for (o, sum) in outputs[..n_out * len]
+                    .iter_mut()
+                    .zip(mixed.chunks_exact(LANES))
+                {
+                    *o += sum.iter().sum::<f64>();
                 }
             }
         }
