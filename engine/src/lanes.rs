@@ -32,10 +32,10 @@ use vector::Ops;
 pub const LANES: usize = 8;
 
 /// The largest model that runs in lanes. A group steps all its lanes while any of them
-/// sounds, so a model whose one voice already fills the vectors costs up to four voices' work
-/// for one note in lanes. Measured (`ressort bench --voices`, 48 kHz): the 102-point faust-mi
-/// string costs 1,401 ns in lanes against 1,822 ns on engines with 16 voices, 462 against
-/// 269 with 2; small models gain at every count (Drunk Triangles: 312 against 615 ns with 16).
+/// sounds and costs about three engines (`VoiceBank::new`), which pays from half a group of
+/// sounding voices for models up to this size: 16 voices of the 102-point faust-mi string
+/// cost 1,111 ns in two groups, where 16 engines would cost 16 × 194 ns = 3,100 ns. The
+/// limit itself was set with four lanes and not moved since.
 pub const MAX_LANE_POINTS: usize = 256;
 
 /// The shortest run of singles with equal coefficients that the mass pass runs reading them
