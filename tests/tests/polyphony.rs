@@ -1,7 +1,7 @@
 //! Polyphony in a CLAP host: with Voices above 1 every note plays its own copy of the model.
-//! A chord is the sum of its notes, voices end themselves with CLAP note-end events, a storm
-//! of notes runs under the allocation check, the setting survives the state, and a new
-//! Voices value from the host takes effect.
+//! A chord is the sum of its notes, a stolen voice fades out without a click, voices end
+//! themselves with CLAP note-end events, a storm of notes runs under the allocation check,
+//! the setting survives the state, and a new Voices value from the host takes effect.
 
 use ressort_tests::{plugin_with_model, Score, Stereo, TestPlugin};
 use serde_json::json;
@@ -74,6 +74,52 @@ fn a_chord_is_the_sum_of_its_notes() {
         diff > 0.1 * peak,
         "one voice cannot play a chord ({diff:.2e})"
     );
+}
+
+/// Stealing makes no click: with two voices the third note steals the quieter voice, which
+/// fades out over a few milliseconds. The difference from a bank with room for all three is
+/// minus the stolen voice times (1 − its fade gain): it moves smoothly, where a cut would
+/// jump by the stolen voice's whole value.
+#[test]
+fn a_stolen_voice_fades_out_without_a_click() {
+    let notes = [(0u32, 60u8), (4_800, 64), (9_600, 67)];
+    let score = notes
+        .iter()
+        .fold(Score::new(), |s, &(t, k)| s.note_on(t, k, 1.0));
+    let frames = 24_000;
+    let mut two = poly(STRUCK, 2);
+    two.take_note_ends();
+    let stolen = render(&mut two, frames, &score);
+    let ends = two.take_note_ends();
+    assert_eq!(ends.len(), 1, "one voice was stolen: {ends:?}");
+    let &(at, victim) = notes
+        .iter()
+        .find(|&&(_, k)| u16::from(k) == ends[0])
+        .expect("the stolen voice is one of the notes");
+    let roomy = render(&mut poly(STRUCK, 3), frames, &score);
+    let alone = render(
+        &mut poly(STRUCK, 3),
+        frames,
+        &Score::new().note_on(at, victim, 1.0),
+    );
+    let d: Vec<f32> = stolen
+        .left
+        .iter()
+        .zip(&roomy.left)
+        .map(|(a, b)| a - b)
+        .collect();
+    let step = d.windows(2).fold(0.0f32, |m, w| m.max((w[1] - w[0]).abs()));
+    let level = alone.slice(9_000..10_200).peak();
+    println!(
+        "note {victim} stolen; its level there {level:.3e}; largest step of the difference \
+         {step:.3e} ({:.1} % of it)",
+        100.0 * step / level
+    );
+    assert!(
+        level > 1e-3,
+        "the stolen voice must still sound when it is stolen"
+    );
+    assert!(step < 0.2 * level, "the stolen voice was cut, not faded");
 }
 
 #[test]
