@@ -45,7 +45,8 @@ use clack_extensions::params::{
 use clack_extensions::state::{HostState, HostStateImpl, PluginState, StateError};
 use clack_extensions::thread_check::{HostThreadCheck, HostThreadCheckImpl};
 use clack_host::events::event_types::{
-    MidiEvent, NoteEndEvent, NoteOffEvent, NoteOnEvent, ParamValueEvent,
+    MidiEvent, NoteEndEvent, NoteExpressionEvent, NoteOffEvent, NoteOnEvent, ParamModEvent,
+    ParamValueEvent,
 };
 use clack_host::events::Match;
 use clack_host::host::HostError;
@@ -56,6 +57,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
+pub use clack_host::events::event_types::NoteExpressionType;
 pub use clack_host::prelude::{ClapId, ProcessStatus};
 
 /// The plugin's CLAP id.
@@ -411,12 +413,13 @@ impl Stereo {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum HostEvent {
     /// A CLAP note-on on note port 0 and MIDI channel `channel` (0 … 15); `velocity` in
-    /// 0..=1.
+    /// 0..=1. `note_id` is the host's id for the note (`None`: -1, no id).
     NoteOn {
         time: u32,
         key: u8,
         velocity: f64,
         channel: u8,
+        note_id: Option<u32>,
     },
     /// A CLAP note-off on note port 0 and MIDI channel `channel`.
     NoteOff {
@@ -424,6 +427,27 @@ pub enum HostEvent {
         key: u8,
         velocity: f64,
         channel: u8,
+        note_id: Option<u32>,
+    },
+    /// A CLAP note expression (tuning in semitones, pressure in 0..=1, …) for the note with
+    /// this key, channel and id.
+    NoteExpression {
+        time: u32,
+        key: u8,
+        channel: u8,
+        note_id: Option<u32>,
+        expression: NoteExpressionType,
+        value: f64,
+    },
+    /// A CLAP polyphonic modulation (`CLAP_EVENT_PARAM_MOD` for one note id): `amount` is
+    /// added to the parameter's value for that note's voice only.
+    PolyModulation {
+        time: u32,
+        id: ClapId,
+        key: u8,
+        channel: u8,
+        note_id: u32,
+        amount: f64,
     },
     /// A MIDI 1 pitch bend on MIDI channel `channel` (`value` in -1..=1, 0 = centre), sent as
     /// a 14-bit CLAP MIDI event.
@@ -444,7 +468,9 @@ impl HostEvent {
             | HostEvent::PitchBend { time, .. }
             | HostEvent::ChannelPressure { time, .. }
             | HostEvent::Controller { time, .. }
-            | HostEvent::Param { time, .. } => time,
+            | HostEvent::Param { time, .. }
+            | HostEvent::NoteExpression { time, .. }
+            | HostEvent::PolyModulation { time, .. } => time,
         }
     }
 
@@ -456,7 +482,9 @@ impl HostEvent {
             | HostEvent::PitchBend { time, .. }
             | HostEvent::ChannelPressure { time, .. }
             | HostEvent::Controller { time, .. }
-            | HostEvent::Param { time, .. } => *time = t,
+            | HostEvent::Param { time, .. }
+            | HostEvent::NoteExpression { time, .. }
+            | HostEvent::PolyModulation { time, .. } => *time = t,
         }
         self
     }
@@ -470,8 +498,9 @@ impl HostEvent {
     }
 
     fn push_to(&self, buffer: &mut EventBuffer) {
-        let note = |key: u8, channel: u8| {
-            Pckn::new(0u16, (channel & 0x0f) as u16, key as u16, Match::<u32>::All)
+        let note = |key: u8, channel: u8, id: Option<u32>| {
+            let id = id.map_or(Match::<u32>::All, Match::Specific);
+            Pckn::new(0u16, (channel & 0x0f) as u16, key as u16, id)
         };
         match *self {
             HostEvent::NoteOn {
@@ -479,13 +508,49 @@ impl HostEvent {
                 key,
                 velocity,
                 channel,
-            } => buffer.push(&NoteOnEvent::new(time, note(key, channel), velocity)),
+                note_id,
+            } => buffer.push(&NoteOnEvent::new(
+                time,
+                note(key, channel, note_id),
+                velocity,
+            )),
             HostEvent::NoteOff {
                 time,
                 key,
                 velocity,
                 channel,
-            } => buffer.push(&NoteOffEvent::new(time, note(key, channel), velocity)),
+                note_id,
+            } => buffer.push(&NoteOffEvent::new(
+                time,
+                note(key, channel, note_id),
+                velocity,
+            )),
+            HostEvent::NoteExpression {
+                time,
+                key,
+                channel,
+                note_id,
+                expression,
+                value,
+            } => buffer.push(&NoteExpressionEvent::new(
+                time,
+                note(key, channel, note_id),
+                expression,
+                value,
+            )),
+            HostEvent::PolyModulation {
+                time,
+                id,
+                key,
+                channel,
+                note_id,
+                amount,
+            } => buffer.push(&ParamModEvent::new(
+                time,
+                id,
+                note(key, channel, Some(note_id)),
+                amount,
+            )),
             HostEvent::PitchBend {
                 time,
                 value,
@@ -600,6 +665,58 @@ impl Score {
             key,
             velocity,
             channel,
+            note_id: None,
+        })
+    }
+
+    /// A note-on on MIDI channel 0 with the host's note id `note_id`, the handle of its
+    /// note expressions and polyphonic modulations.
+    pub fn note_on_id(self, frame: u32, key: u8, velocity: f64, note_id: u32) -> Score {
+        self.event(HostEvent::NoteOn {
+            time: frame,
+            key,
+            velocity,
+            channel: 0,
+            note_id: Some(note_id),
+        })
+    }
+
+    /// A CLAP note expression for the note on channel 0 with this key and id.
+    pub fn note_expression(
+        self,
+        frame: u32,
+        key: u8,
+        note_id: u32,
+        expression: NoteExpressionType,
+        value: f64,
+    ) -> Score {
+        self.event(HostEvent::NoteExpression {
+            time: frame,
+            key,
+            channel: 0,
+            note_id: Some(note_id),
+            expression,
+            value,
+        })
+    }
+
+    /// A CLAP polyphonic modulation of parameter `id` by `amount` for the note on channel 0
+    /// with this key and id.
+    pub fn poly_modulation(
+        self,
+        frame: u32,
+        id: ClapId,
+        key: u8,
+        note_id: u32,
+        amount: f64,
+    ) -> Score {
+        self.event(HostEvent::PolyModulation {
+            time: frame,
+            id,
+            key,
+            channel: 0,
+            note_id,
+            amount,
         })
     }
 
@@ -610,6 +727,7 @@ impl Score {
             key,
             velocity: 0.0,
             channel: 0,
+            note_id: None,
         })
     }
 

@@ -1,9 +1,14 @@
 //! Polyphony in a CLAP host: with Voices above 1 every note plays its own copy of the model.
 //! A chord is the sum of its notes, a stolen voice fades out without a click, voices end
 //! themselves with CLAP note-end events, a storm of notes runs under the allocation check,
-//! the setting survives the state, and a new Voices value from the host takes effect.
+//! the setting survives the state, and a new Voices value from the host takes effect. MPE
+//! bends and pressure, CLAP note expressions and CLAP polyphonic modulation each reach only
+//! the voice they address.
 
-use ressort_tests::{plugin_with_model, Score, Stereo, TestPlugin};
+use ressort_tests::{
+    band_energy_share, cents, peak_frequency, plugin_with_model, NoteExpressionType, Score, Stereo,
+    TestPlugin,
+};
 use serde_json::json;
 
 const SR: f64 = 48_000.0;
@@ -218,7 +223,6 @@ fn the_voices_setting_survives_the_state_and_follows_the_host() {
 /// moves only the voice of that channel: measured by FFT.
 #[test]
 fn an_mpe_bend_moves_only_its_channels_voice() {
-    use ressort_tests::{cents, peak_frequency};
     let frames = 48_000;
     let mut plugin = plugin_with_model(
         "poly",
@@ -291,7 +295,6 @@ fn an_mpe_bend_moves_only_its_channels_voice() {
 /// voice's step response alone (FFT), with nothing at the other voice's pitch.
 #[test]
 fn mpe_channel_pressure_presses_only_its_channels_voice() {
-    use ressort_tests::{band_energy_share, cents, peak_frequency};
     let frames = 48_000;
     let script = format!("{DAMPED_SLOWLY}~pressure in1 0.001\n");
     let settings = [
@@ -311,12 +314,6 @@ fn mpe_channel_pressure_presses_only_its_channels_voice() {
         frames,
         &chord.clone().channel_pressure(4_800, 1.0, 2),
     );
-    let diff: Vec<f32> = pressed
-        .left
-        .iter()
-        .zip(&plain.left)
-        .map(|(a, b)| a - b)
-        .collect();
     let alone = |key: u8| {
         let mut p = plugin_with_model("poly", &script, &settings);
         render(
@@ -330,26 +327,255 @@ fn mpe_channel_pressure_presses_only_its_channels_voice() {
         peak_frequency(&alone(60), SR, 20.0, 20_000.0),
         peak_frequency(&alone(67), SR, 20.0, 20_000.0),
     );
+    only_one_voice_moved(
+        "MPE pressure on channel 3",
+        &pressed,
+        &plain,
+        4_800,
+        f67,
+        f60,
+    );
+}
+
+/// Checks that an event sent at frame `at` changed exactly one voice of a chord: `changed`
+/// and `plain` (the chord without the event) are equal before `at`; after it their
+/// difference rings at `f_moved`, the pitch of the voice the event addressed, and holds
+/// nothing at `f_other`, the other voice's pitch.
+fn only_one_voice_moved(
+    what: &str,
+    changed: &Stereo,
+    plain: &Stereo,
+    at: usize,
+    f_moved: f64,
+    f_other: f64,
+) {
+    let diff: Vec<f32> = changed
+        .left
+        .iter()
+        .zip(&plain.left)
+        .map(|(a, b)| a - b)
+        .collect();
     let peak = diff.iter().fold(0.0f32, |m, v| m.max(v.abs()));
-    let ring = peak_frequency(&diff[4_800..], SR, 20.0, 20_000.0);
-    let share60 = band_energy_share(&diff[4_800..], SR, f60 / 1.01, f60 * 1.01);
+    let ring = peak_frequency(&diff[at..], SR, 20.0, 20_000.0);
+    let other = band_energy_share(&diff[at..], SR, f_other / 1.01, f_other * 1.01);
     println!(
-        "pressure on channel 3: difference peak {peak:.2e}, rings at {ring:.2} Hz \
-         ({:+.2} ct from note 67), energy share at note 60 {share60:.2e}",
-        cents(ring, f67)
+        "{what}: difference peak {peak:.2e}, rings at {ring:.2} Hz ({:+.2} ct from the \
+         addressed voice), energy share at the other voice's pitch {other:.2e}",
+        cents(ring, f_moved)
     );
-    assert!(peak > 1e-4, "the pressure did not move anything ({peak:e})");
+    assert!(peak > 1e-4, "{what} did not move anything ({peak:e})");
     assert!(
-        cents(ring, f67).abs() < 5.0,
-        "the pressed voice is not note 67's"
+        cents(ring, f_moved).abs() < 5.0,
+        "{what} moved another voice than the one it addressed"
+    );
+    assert!(other < 1e-3, "{what} moved the other voice too ({other:e})");
+    assert!(
+        diff[..at].iter().all(|v| *v == 0.0),
+        "{what} acted before it was sent"
+    );
+}
+
+/// The frequency of note `key` of `script` played alone on channel 0 (8 voices).
+fn pitch_alone(script: &str, key: u8) -> f64 {
+    let mut p = poly(script, 8);
+    let alone = render(&mut p, 48_000, &Score::new().note_on(0, key, 0.9));
+    peak_frequency(&alone.left, SR, 20.0, 20_000.0)
+}
+
+/// CLAP note expressions address one voice by its note id. The tuning expression (+12
+/// semitones, sent with the note) plays note 60's voice as note 72, bit for bit, next to an
+/// untouched note 55. Sent later to one voice of a sounding chord, it retunes that voice only.
+#[test]
+fn a_clap_tuning_expression_retunes_only_its_note() {
+    let frames = 24_000;
+    let mut plugin = poly(STRUCK, 8);
+    let tuned = render(
+        &mut plugin,
+        frames,
+        &Score::new()
+            .note_on_id(0, 60, 0.9, 7)
+            .note_expression(0, 60, 7, NoteExpressionType::Tuning, 12.0)
+            .note_on_id(0, 55, 0.9, 8),
+    );
+    let played = render(
+        &mut plugin,
+        frames,
+        &Score::new()
+            .note_on_id(0, 72, 0.9, 7)
+            .note_on_id(0, 55, 0.9, 8),
+    );
+    println!(
+        "tuning +12 on note id 7 (note 60) against note 72 played: first difference {:?}",
+        tuned.first_difference(&played)
     );
     assert!(
-        share60 < 1e-3,
-        "note 60's voice was pressed too ({share60:e})"
+        tuned.bit_identical(&played),
+        "tuning +12 must play note 60 as 72"
+    );
+
+    // Mid-note, on a lightly damped chord: only the addressed voice moves.
+    let chord = Score::new()
+        .note_on_id(0, 60, 0.9, 1)
+        .note_on_id(0, 67, 0.9, 2);
+    let mut plugin = poly(DAMPED_SLOWLY, 8);
+    let plain = render(&mut plugin, 48_000, &chord);
+    let bent = render(
+        &mut plugin,
+        48_000,
+        &chord
+            .clone()
+            .note_expression(4_800, 67, 2, NoteExpressionType::Tuning, 5.0),
+    );
+    let (f60, f67, f72) = (
+        pitch_alone(DAMPED_SLOWLY, 60),
+        pitch_alone(DAMPED_SLOWLY, 67),
+        pitch_alone(DAMPED_SLOWLY, 72),
+    );
+    let high = peak_frequency(&bent.left[4_800..], SR, f72 / 1.03, f72 * 1.03);
+    let left67 = band_energy_share(&bent.left[4_800..], SR, f67 / 1.01, f67 * 1.01);
+    println!(
+        "tuning +5 on note id 2 (note 67) at 0.1 s: peak at {high:.2} Hz ({:+.2} ct from note \
+         72); energy share left at note 67 {left67:.2e}",
+        cents(high, f72)
+    );
+    assert!(left67 < 1e-3, "note 67 still sounds ({left67:e})");
+    assert!(
+        cents(high, f72).abs() < 2.0,
+        "note 67 + 5 semitones must sound as note 72"
+    );
+    // The difference rings at both the old and the new pitch of voice 2; none of it at note 60.
+    only_one_voice_moved("tuning on note id 2", &bent, &plain, 4_800, f72, f60);
+}
+
+/// The CLAP pressure expression presses the voice of its note id through the script's
+/// `~pressure` input: a sustained force whose step response rings at that voice's pitch only.
+#[test]
+fn a_clap_pressure_expression_presses_only_its_note() {
+    let script = format!("{DAMPED_SLOWLY}~pressure in1 0.001\n");
+    let settings = [
+        ("voices", json!({ "i32": 8 })),
+        ("output_gain", json!({ "f32": -12.0 })),
+        ("dc_filter", json!({ "bool": false })),
+    ];
+    let chord = Score::new()
+        .note_on_id(0, 60, 0.9, 11)
+        .note_on_id(0, 67, 0.9, 12);
+    let mut plugin = plugin_with_model("poly", &script, &settings);
+    let plain = render(&mut plugin, 48_000, &chord);
+    let pressed = render(
+        &mut plugin,
+        48_000,
+        &chord
+            .clone()
+            .note_expression(4_800, 67, 12, NoteExpressionType::Pressure, 1.0),
+    );
+    let (f60, f67) = (pitch_alone(&script, 60), pitch_alone(&script, 67));
+    only_one_voice_moved("pressure on note id 12", &pressed, &plain, 4_800, f67, f60);
+}
+
+/// CLAP polyphonic modulation of Stiffness and Damping (Ressort declares both modulatable per
+/// note id) reaches only the voice of its note id. Stiffness +2 octaves (+0.25 of the
+/// knob's 8-octave span) multiplies that voice's K by 4: in the discrete oscillator,
+/// sin(ω/2) = √(K/4M), its pitch moves from ω to 2·asin(2·sin(ω/2)), a little above an octave.
+/// Damping +2 octaves makes it decay four times as fast (the envelope's rate is Z/2M per
+/// sample). The other voice stays as it was.
+#[test]
+fn clap_polyphonic_modulation_moves_only_its_note() {
+    const CLAP_PARAM_IS_MODULATABLE: u32 = 1 << 10;
+    const CLAP_PARAM_IS_MODULATABLE_PER_NOTE_ID: u32 = 1 << 11;
+    let mut plugin = poly(DAMPED_SLOWLY, 8);
+    let (stiffness, damping) = (plugin.param("Stiffness"), plugin.param("Damping"));
+    for p in [&stiffness, &damping] {
+        println!(
+            "{}: range {} … {}, flags {:#x}",
+            p.name, p.min, p.max, p.flags
+        );
+        let per_note = CLAP_PARAM_IS_MODULATABLE | CLAP_PARAM_IS_MODULATABLE_PER_NOTE_ID;
+        assert_eq!(
+            p.flags & per_note,
+            per_note,
+            "{} is not poly-modulatable",
+            p.name
+        );
+    }
+    // A quarter of the span: 2 of the knob's ±4 octaves.
+    let quarter = (stiffness.max - stiffness.min) / 4.0;
+    let chord = Score::new()
+        .note_on_id(0, 60, 0.9, 3)
+        .note_on_id(0, 67, 0.9, 4);
+    let plain = render(&mut plugin, 48_000, &chord);
+    let (f60, f67, f72) = (
+        pitch_alone(DAMPED_SLOWLY, 60),
+        pitch_alone(DAMPED_SLOWLY, 67),
+        pitch_alone(DAMPED_SLOWLY, 72),
+    );
+
+    let stiffer = render(
+        &mut plugin,
+        48_000,
+        &chord
+            .clone()
+            .poly_modulation(0, stiffness.id, 60, 3, quarter),
+    );
+    let half_angle = std::f64::consts::PI * f60 / SR;
+    let f4k = SR / std::f64::consts::PI * (2.0 * half_angle.sin()).asin();
+    let high = peak_frequency(&stiffer.left, SR, f72 / 1.03, f72 * 1.03);
+    let kept = peak_frequency(&stiffer.left, SR, f67 / 1.03, f67 * 1.03);
+    let left60 = band_energy_share(&stiffer.left, SR, f60 / 1.01, f60 * 1.01);
+    println!(
+        "Stiffness +2 octaves on note id 3 (note 60 at {f60:.2} Hz): {high:.2} Hz, {:+.2} ct \
+         from 4K's {f4k:.2} Hz ({:+.2} ct from note 72); note 67 at {kept:.2} Hz ({:+.2} ct); \
+         energy share left at note 60 {left60:.2e}",
+        cents(high, f4k),
+        cents(high, f72),
+        cents(kept, f67)
     );
     assert!(
-        diff[..4_800].iter().all(|v| *v == 0.0),
-        "pressure acted before it was sent"
+        cents(high, f4k).abs() < 1.0,
+        "the modulated voice's K must be ×4"
+    );
+    assert!(cents(kept, f67).abs() < 2.0, "the other voice moved");
+    assert!(
+        left60 < 1e-3,
+        "note 60 still sounds at its own pitch ({left60:e})"
+    );
+
+    // Damping, sent a tenth of a second into the chord.
+    let damped = render(
+        &mut plugin,
+        48_000,
+        &chord
+            .clone()
+            .poly_modulation(4_800, damping.id, 60, 3, quarter),
+    );
+    only_one_voice_moved("Damping on note id 3", &damped, &plain, 4_800, f60, f67);
+    // The decay rate of note 60's voice, from its level in two windows, with and without.
+    let alone = Score::new().note_on_id(0, 60, 0.9, 3);
+    let rate = |score: &Score, plugin: &mut TestPlugin| {
+        let y = render(plugin, 48_000, score).left;
+        let rms = |r: std::ops::Range<usize>| {
+            (y[r.clone()]
+                .iter()
+                .map(|v| (*v as f64).powi(2))
+                .sum::<f64>()
+                / r.len() as f64)
+                .sqrt()
+        };
+        (rms(6_000..10_000) / rms(14_000..18_000)).ln() / 8_000.0
+    };
+    let free = rate(&alone, &mut plugin);
+    let modulated = rate(
+        &alone.clone().poly_modulation(0, damping.id, 60, 3, quarter),
+        &mut plugin,
+    );
+    println!(
+        "decay rate of note 60: {free:.3e} per sample free, {modulated:.3e} with Damping +2 \
+         octaves on its note id: {:.3}×",
+        modulated / free
+    );
+    assert!(
+        (modulated / free - 4.0).abs() < 0.2,
+        "Damping ×4 must make the voice decay 4× as fast"
     );
 }
 
