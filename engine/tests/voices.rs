@@ -1,6 +1,7 @@
 //! Polyphony in the instrument: every note its own copy of the model. A chord is the sum of
 //! its notes, a bank of one voice is the monophonic engine, voices free themselves at rest,
-//! stealing does not click, and the sustain pedal holds notes.
+//! stealing does not click, the sustain pedal holds notes, and the motion view shows the
+//! most recently struck voice.
 
 use ressort_engine::instrument::{self, Controls, Event, Instrument, Timed, MAX_HOST_INPUTS};
 
@@ -571,4 +572,73 @@ fn voices_on_one_note_share_gains_only_with_the_same_modulation() {
         "the voices must sound below the knee ({p})"
     );
     assert!(err <= 1e-6 * p, "{err} > 1e-6 × {p}");
+}
+
+/// Records every position snapshot the instrument hands its watcher (the editor's motion
+/// view), one per chunk.
+#[derive(Debug, Default, Clone)]
+struct Recorder(std::sync::Arc<std::sync::Mutex<Vec<Vec<f64>>>>);
+
+impl instrument::Watcher for Recorder {
+    fn tick(&mut self, _frames: usize, positions: &[f64], _watching: bool) {
+        self.0.lock().unwrap().push(positions.to_vec());
+    }
+}
+
+/// The positions the motion view is shown, chunk by chunk, while `events` play on 8 voices.
+fn watched(script: &str, events: &[(u32, Event)], frames: usize) -> Vec<Vec<f64>> {
+    let mut model = instrument::prepare("test", script, SR).unwrap();
+    model.set_voices(8);
+    let recorder = Recorder::default();
+    model.watcher = Some(Box::new(recorder.clone()));
+    let mut inst = Instrument::new(SR, quiet());
+    inst.set_model(Box::new(model));
+    inst.set_watching(true);
+    let block = 256;
+    let (mut left, mut right) = (vec![0.0f32; block], vec![0.0f32; block]);
+    let mut start = 0;
+    while start < frames {
+        let n = block.min(frames - start);
+        let mut ev = events
+            .iter()
+            .filter(|(t, _)| (*t as usize) >= start && (*t as usize) < start + n)
+            .map(|&(t, e)| Timed::new(t - start as u32, e));
+        let host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+        let mut out: [&mut [f32]; 2] = [&mut left[..n], &mut right[..n]];
+        inst.process(n, &host, false, &mut ev, &quiet(), &mut out);
+        start += n;
+    }
+    let ticks = recorder.0.lock().unwrap().clone();
+    ticks
+}
+
+#[test]
+fn the_motion_view_shows_the_most_recently_struck_voice() {
+    // Note 60 at 0, note 67 at 4,800 (a chunk boundary): from then on the view shows note
+    // 67's voice, which moves exactly as note 67 played alone; before, note 60's.
+    let (first, second) = (on(60, 0, None), on(67, 0, None));
+    let frames = 9_600;
+    let both = watched(STRING, &[(0, first), (4_800, second)], frames);
+    let only_first = watched(STRING, &[(0, first)], frames);
+    let only_second = watched(STRING, &[(4_800, second)], frames);
+    assert_eq!(both.len(), only_second.len());
+    let chunk = frames / both.len();
+    let switch = 4_800 / chunk;
+    let moving = |ticks: &[Vec<f64>]| ticks.iter().flatten().any(|x| *x != 0.0);
+    assert!(moving(&both[..switch]) && moving(&both[switch..]));
+    assert_eq!(
+        both[..switch],
+        only_first[..switch],
+        "before the second note the view shows the first note's voice"
+    );
+    assert_eq!(
+        both[switch..],
+        only_second[switch..],
+        "after it, the view shows the second note's voice"
+    );
+    assert_ne!(
+        both[switch..],
+        only_first[switch..],
+        "the view must leave the first voice"
+    );
 }
