@@ -182,6 +182,17 @@ fn the_voices_setting_survives_the_state_and_follows_the_host() {
         ressort_tests::state::param(&saved, "voices"),
         Some(json!({ "i32": 6 }))
     );
+    // Voices counts notes (0: the script's `~voices`), is not automatable (a new count
+    // re-prepares the model), and Release is an ordinary automatable control.
+    const CLAP_PARAM_IS_AUTOMATABLE: u32 = 1 << 5;
+    let (voices, release) = (first.param("Voices"), first.param("Release"));
+    println!(
+        "Voices: {} … {}, flags {:#x}; Release: {} … {}, flags {:#x}",
+        voices.min, voices.max, voices.flags, release.min, release.max, release.flags
+    );
+    assert!(voices.min <= 1.0 && voices.max >= 64.0);
+    assert_eq!(voices.flags & CLAP_PARAM_IS_AUTOMATABLE, 0);
+    assert_ne!(release.flags & CLAP_PARAM_IS_AUTOMATABLE, 0);
     let mut second = TestPlugin::new();
     second.load_state(&saved).unwrap();
     let b = render(&mut second, frames, &chord);
