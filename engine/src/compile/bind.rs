@@ -12,6 +12,7 @@ use crate::engine::{
     SingleMasses,
 };
 use crate::expr::Expr;
+use crate::kernels::masses::Update;
 use crate::spec::{ElementKind, MacroKind, SampleRateMode, REFERENCE_SAMPLE_RATE_HZ};
 
 /// The bound kinds, ready to run.
@@ -77,7 +78,7 @@ impl<'a> Cx<'a> {
             fixed: vec![false; n_single],
             audio: vec![false; n_single],
             cols,
-            runs: vec![(0, 0, false); n_single],
+            runs: vec![(0, 0, Update::General); n_single],
             num_runs: 0,
         };
         let mut audio_masses = Vec::new();

@@ -39,6 +39,7 @@ pub(crate) fn arch_for(macros: &macros::Macros) -> pulp::Arch {
 
 #[cfg(test)]
 mod tests {
+    use super::masses::Update;
     use crate::{compile, parse, CompileOptions};
 
     /// A band of links (a string written element by element, the rows of a mesh, the links
@@ -312,10 +313,11 @@ mod tests {
                 20 => "@m20 ground 0.1
 "
                 .to_string(),
+                // Unequal masses first (plain runs), then equal ones (uniform runs).
                 _ => format!(
                     "@m{i} mass {}. 0. 0.
 ",
-                    1 + i % 3
+                    if i < 13 { 1 + i % 3 } else { 1 }
                 ),
             };
         }
@@ -337,7 +339,9 @@ mod tests {
         let mut fast = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
         let runs = |e: &crate::Engine| e.singles.runs[..e.singles.num_runs].to_vec();
         assert!(
-            runs(&fast).iter().any(|r| r.2 && r.1 > 4),
+            [Update::Plain, Update::PlainUniform]
+                .iter()
+                .all(|&u| runs(&fast).iter().any(|r| r.2 == u && r.1 > 4)),
             "{:?}",
             runs(&fast)
         );
@@ -356,10 +360,10 @@ mod tests {
             // m7 is point 8 (the ground g0 is point 0).
             let plain_osc = runs(&fast)
                 .iter()
-                .any(|r| r.2 && (r.0..r.0 + r.1).contains(&8));
+                .any(|r| r.2 != Update::General && (r.0..r.0 + r.1).contains(&8));
             assert_eq!(plain_osc, value == 0.0, "{:?}", runs(&fast));
             let n = general.singles.len() as u32;
-            general.singles.runs[0] = (0, n, false);
+            general.singles.runs[0] = (0, n, Update::General);
             general.singles.num_runs = 1;
             fast.process(frames, &input, &mut a);
             general.process(frames, &input, &mut b);
