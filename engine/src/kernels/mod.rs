@@ -114,6 +114,22 @@ mod tests {
             let merged = chain_and_scatter_agree(&text, w as u32);
             assert_eq!(merged, odd.is_none());
         }
+        // Long forward bands run in tiles of TILE links: a 700-mass string, uniform or with one
+        // odd link, and 7 interleaved strings (d = 7) of 515 links, whose last tile is shorter
+        // than d. The strike and the output sit on either side of the tile seams.
+        for (masses, d, odd) in [(700, 1, None), (700, 1, Some(300)), (522, 7, None)] {
+            let mut text = String::from("@g0 ground 0.\n");
+            for i in 0..masses {
+                text += &format!("@m{i} mass 1. 0. 0.\n");
+            }
+            for i in 0..masses - d {
+                let stiffness = if odd == Some(i) { 0.12 } else { 0.1 };
+                text += &format!("@l{i} springDamper @m{i} @m{} {stiffness} 0.001\n", i + d);
+            }
+            text += "@p springDamper @g0 @m0 0.1 0.001\n@in1 frcInput @m500\n";
+            text += "@out1 posOutput @m255\n";
+            assert!(!chain_and_scatter_agree(&text, d as u32));
+        }
     }
 
     /// A string written from its far end (every link (i + 1, i)) is the same string: each
