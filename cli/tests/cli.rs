@@ -296,7 +296,8 @@ fn bench_ends_with_the_machine_readable_line() {
             "realtime_factor",
             "points",
             "interactions",
-            "compile_ms"
+            "compile_ms",
+            "mean_ns"
         ]
     );
     for (k, v) in &fields {
