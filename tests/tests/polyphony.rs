@@ -3,7 +3,7 @@
 //! themselves with CLAP note-end events, a storm of notes runs under the allocation check,
 //! the setting survives the state, and a new Voices value from the host takes effect. MPE
 //! bends and pressure, CLAP note expressions and CLAP polyphonic modulation each reach only
-//! the voice they address.
+//! the voice they address. Release damps a released voice, and the sustain pedal holds it.
 
 use ressort_tests::{
     band_energy_share, cents, peak_frequency, plugin_with_model, NoteExpressionType, Score, Stereo,
@@ -596,3 +596,42 @@ const DAMPED_SLOWLY: &str = "\
 @in1 frcInput @o
 @out1 posOutput @o
 ";
+
+/// Release and the sustain pedal through the host: with Release at 100 %, a note-off lays a
+/// damper on its voice (Damping × 16), so the voice is nearly silent half a second later,
+/// while a held note still rings; with the pedal (CC 64) down, the note-off waits and the
+/// voice rings as if held, bit for bit.
+#[test]
+fn release_damps_a_released_voice_and_the_pedal_holds_it() {
+    let settings = [
+        ("voices", json!({ "i32": 8 })),
+        ("output_gain", json!({ "f32": -12.0 })),
+        ("release", json!({ "f32": 1.0 })),
+    ];
+    let frames = 48_000;
+    let tail = |score: &Score| {
+        let mut plugin = plugin_with_model("poly", DAMPED_SLOWLY, &settings);
+        let out = render(&mut plugin, frames, score);
+        (out.slice(36_000..frames).peak(), out)
+    };
+    let held = Score::new().note_on(0, 60, 0.9);
+    let (held_peak, held_out) = tail(&held);
+    let (released_peak, _) = tail(&held.clone().note_off(4_800, 60));
+    let (pedal_peak, pedal_out) = tail(&held.clone().controller(100, 64, 127).note_off(4_800, 60));
+    println!(
+        "tail peak (0.75 … 1 s): held {held_peak:.3e}, released at 0.1 s {released_peak:.3e}, \
+         released under the pedal {pedal_peak:.3e}"
+    );
+    assert!(
+        held_peak > 1e-3,
+        "the held note must still ring ({held_peak:e})"
+    );
+    assert!(
+        released_peak < held_peak * 1e-3,
+        "Release must damp the released voice ({released_peak:e} vs {held_peak:e})"
+    );
+    assert!(
+        pedal_out.bit_identical(&held_out),
+        "under the pedal a note-off must wait"
+    );
+}
