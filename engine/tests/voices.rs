@@ -48,6 +48,18 @@ fn render_with(
     model.set_voices(voices);
     let mut inst = Instrument::new(SR, controls);
     inst.set_model(Box::new(model));
+    play(&mut inst, controls, events, frames, sidechain)
+}
+
+/// Plays `events` on `inst` in blocks of 256 frames, noting the notes whose voices ended and
+/// the voices sounding after each block.
+fn play(
+    inst: &mut Instrument,
+    controls: Controls,
+    events: &[(u32, Event)],
+    frames: usize,
+    sidechain: Option<&[f32]>,
+) -> Render {
     let block = 256;
     let mut left = vec![0.0f32; frames];
     let mut right = vec![0.0f32; frames];
@@ -594,20 +606,7 @@ fn watched(script: &str, events: &[(u32, Event)], frames: usize) -> Vec<Vec<f64>
     let mut inst = Instrument::new(SR, quiet());
     inst.set_model(Box::new(model));
     inst.set_watching(true);
-    let block = 256;
-    let (mut left, mut right) = (vec![0.0f32; block], vec![0.0f32; block]);
-    let mut start = 0;
-    while start < frames {
-        let n = block.min(frames - start);
-        let mut ev = events
-            .iter()
-            .filter(|(t, _)| (*t as usize) >= start && (*t as usize) < start + n)
-            .map(|&(t, e)| Timed::new(t - start as u32, e));
-        let host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
-        let mut out: [&mut [f32]; 2] = [&mut left[..n], &mut right[..n]];
-        inst.process(n, &host, false, &mut ev, &quiet(), &mut out);
-        start += n;
-    }
+    play(&mut inst, quiet(), events, frames, None);
     let ticks = recorder.0.lock().unwrap().clone();
     ticks
 }

@@ -225,19 +225,16 @@ impl Group {
                 let (xl, xh) = (&x[q..q + m], &x[q + d..q + d + m]);
                 let (xpl, xph) = (&xp[q..q + m], &xp[q + d..q + d + m]);
                 let s = &mut scratch[..m];
-                if uniform && m >= UNIFORM_MIN {
-                    for j in 0..m {
-                        let dx = xh[j] - xl[j];
-                        let dv = (xh[j] - xph[j]) - (xl[j] - xpl[j]);
-                        s[j] = law(start, dx, dv);
-                    }
-                } else {
-                    for j in 0..m {
-                        let dx = xh[j] - xl[j];
-                        let dv = (xh[j] - xph[j]) - (xl[j] - xpl[j]);
-                        s[j] = law(start + j, dx, dv);
-                    }
-                }
+                band_forces(
+                    start,
+                    uniform && m >= UNIFORM_MIN,
+                    xh,
+                    xl,
+                    xph,
+                    xpl,
+                    s,
+                    &law,
+                );
                 let fs = &mut f[q..q + m + d];
                 for t in 0..m.min(d) {
                     fs[t] += s[t];
@@ -266,20 +263,16 @@ impl Group {
                 continue;
             }
             let s = &mut scratch[..m];
-            if uniform && m >= UNIFORM_MIN {
-                // Every link's arguments are the first link's: read once, outside the loop.
-                for j in 0..m {
-                    let dx = xa[j] - xb[j];
-                    let dv = (xa[j] - xpa[j]) - (xb[j] - xpb[j]);
-                    s[j] = law(start, dx, dv);
-                }
-            } else {
-                for j in 0..m {
-                    let dx = xa[j] - xb[j];
-                    let dv = (xa[j] - xpa[j]) - (xb[j] - xpb[j]);
-                    s[j] = law(start + j, dx, dv);
-                }
-            }
+            band_forces(
+                start,
+                uniform && m >= UNIFORM_MIN,
+                xa,
+                xb,
+                xpa,
+                xpb,
+                s,
+                &law,
+            );
             let fs = &mut f[q..q + m + d];
             for t in 0..m.min(d) {
                 fs[t] -= s[t];
@@ -298,6 +291,39 @@ impl Group {
             c += 1;
         }
         scatter(i, &a[i..], &b[i..], x, xp, f, &law);
+    }
+}
+
+/// The forces s_j = law(link, Δx, Δv) of a band's links j = 0 … s.len() − 1, with
+/// Δx = x₁ − x₂ and Δv = (x₁ − x̃₁) − (x₂ − x̃₂) from their first and second ends' positions.
+/// Link j is number `first + j`; when `uniform`, every link's arguments are the first one's,
+/// read once, outside the loop.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn band_forces(
+    first: usize,
+    uniform: bool,
+    x1: &[f64],
+    x2: &[f64],
+    xp1: &[f64],
+    xp2: &[f64],
+    s: &mut [f64],
+    law: &impl Fn(usize, f64, f64) -> f64,
+) {
+    let m = s.len();
+    let (x1, x2, xp1, xp2) = (&x1[..m], &x2[..m], &xp1[..m], &xp2[..m]);
+    if uniform {
+        for j in 0..m {
+            let dx = x1[j] - x2[j];
+            let dv = (x1[j] - xp1[j]) - (x2[j] - xp2[j]);
+            s[j] = law(first, dx, dv);
+        }
+    } else {
+        for j in 0..m {
+            let dx = x1[j] - x2[j];
+            let dv = (x1[j] - xp1[j]) - (x2[j] - xp2[j]);
+            s[j] = law(first + j, dx, dv);
+        }
     }
 }
 
@@ -327,20 +353,16 @@ fn forward_band_tiled(
         let len = TILE.min(m - j0);
         let (xa, xb) = (&xa[j0..j0 + len], &xb[j0..j0 + len]);
         let (xpa, xpb) = (&xpa[j0..j0 + len], &xpb[j0..j0 + len]);
-        let now = &mut w[d..d + len];
-        if uniform {
-            for j in 0..len {
-                let dx = xa[j] - xb[j];
-                let dv = (xa[j] - xpa[j]) - (xb[j] - xpb[j]);
-                now[j] = law(start, dx, dv);
-            }
-        } else {
-            for j in 0..len {
-                let dx = xa[j] - xb[j];
-                let dv = (xa[j] - xpa[j]) - (xb[j] - xpb[j]);
-                now[j] = law(start + j0 + j, dx, dv);
-            }
-        }
+        band_forces(
+            start + j0,
+            uniform,
+            xa,
+            xb,
+            xpa,
+            xpb,
+            &mut w[d..d + len],
+            law,
+        );
         // Points j0 … j0 + len − 1: the first d of the band only lose s_t.
         let head = d.saturating_sub(j0).min(len);
         let fs_tile = &mut fs[j0..j0 + len];
