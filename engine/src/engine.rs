@@ -381,7 +381,10 @@ impl Engine {
         &self.points.xp
     }
 
-    /// Force accumulators, in the order of [`Engine::positions`].
+    /// Force accumulators, in the order of [`Engine::positions`]. The nodes of a mesh of
+    /// [`ROW_SWEEP_NODES`](crate::kernels::mesh::ROW_SWEEP_NODES) nodes or more hold only the
+    /// forces their connection points spread: the row sweep computes the mesh's own link
+    /// forces when it uses them.
     pub fn forces(&self) -> &[f64] {
         &self.points.f
     }
@@ -392,6 +395,7 @@ impl Engine {
     pub fn reset(&mut self) {
         self.refresh_control();
         self.points.f.fill(0.0);
+        self.macros.reset();
         for run in &self.init_runs {
             let x0 = self.program.eval(run.x0, &self.params, &mut self.stack);
             let xp = match run.rule {
@@ -708,7 +712,8 @@ impl Engine {
         }
         // Stage 2 a: single mass-type elements; 2 b: macros and their internal links.
         self.singles.step(&mut self.points);
-        self.macros.step(&mut self.points, &self.args);
+        self.macros
+            .step(&mut self.points, &self.args, &self.proxies);
         // Stage 3: connection-point positions.
         self.proxies.update_positions(&mut self.points);
         // Stage 4: interactions, then force inputs.
@@ -782,8 +787,11 @@ impl Engine {
     #[inline(always)]
     fn flush_tiny(&mut self) {
         let p = &mut self.points;
-        for v in p.x.iter_mut().chain(p.xp.iter_mut()).chain(p.f.iter_mut()) {
-            *v = if v.abs() < FLUSH_BELOW { 0.0 } else { *v };
+        // One loop per array: a chain of the three does not vectorise.
+        for a in [&mut p.x, &mut p.xp, &mut p.f] {
+            for v in a.iter_mut() {
+                *v = if v.abs() < FLUSH_BELOW { 0.0 } else { *v };
+            }
         }
     }
 }

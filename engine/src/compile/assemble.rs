@@ -91,7 +91,9 @@ impl<'a> Cx<'a> {
             bound.singles.len(),
             proxies.coord_slots.iter().flatten().copied(),
         );
-        let arch = crate::kernels::arch_for(&bound.macros);
+        let mut macros = bound.macros;
+        macros.scratch_ext = vec![(0, 0.0); 4 * num_proxies];
+        let arch = crate::kernels::arch_for(&macros);
         let mut engine = Engine {
             info,
             points: Points {
@@ -102,7 +104,7 @@ impl<'a> Cx<'a> {
             },
             args: self.args,
             singles: bound.singles,
-            macros: bound.macros,
+            macros,
             proxies,
             interactions,
             avatars: avatars.into_iter().map(|(_, route)| route).collect(),

@@ -1,7 +1,8 @@
 //! Stage 2 b of spec §1.5: the macro structures (strings, chains, stiff strings, meshes,
 //! spec §2.7), each updating its nodes and then adding its internal forces.
 
-use crate::engine::Points;
+use crate::engine::{Points, Proxies};
+use crate::kernels::mesh::{mesh_step_passes, mesh_step_rows, ROW_SWEEP_NODES};
 use crate::laws;
 
 /// The argument slots of one macro in `Engine::args`: M, K, K2 (stiff strings), Z, Zo.
@@ -33,6 +34,9 @@ pub(crate) struct MeshMacro {
     /// Local indices of pinned nodes (corners or border).
     pub pinned: Vec<u32>,
     pub slots: MacroSlots,
+    /// K and Z of the previous sample, (0, 0) before the first: the row sweep computes the
+    /// previous sample's link forces with them ([`mesh_step_rows`]).
+    pub last_kz: (f64, f64),
 }
 
 /// The per-step coefficients of the ground-friction node law of spec §2.7:
@@ -53,11 +57,21 @@ pub(crate) struct Macros {
     pub scratch_v: Vec<f64>,
     /// Link forces of the macro being computed.
     pub scratch_s: Vec<f64>,
+    /// The forces the connection points spread onto a large mesh's nodes (local node, force),
+    /// ascending; four entries per connection point.
+    pub scratch_ext: Vec<(u32, f64)>,
 }
 
 impl Macros {
+    /// Clears the state the macros keep between samples (spec §1.5 stage 0: no force yet).
+    pub(crate) fn reset(&mut self) {
+        for mac in &mut self.meshes {
+            mac.last_kz = (0.0, 0.0);
+        }
+    }
+
     #[inline(always)]
-    pub(crate) fn step(&mut self, p: &mut Points, args: &[f64]) {
+    pub(crate) fn step(&mut self, p: &mut Points, args: &[f64], proxies: &Proxies) {
         let (v, s) = (&mut self.scratch_v, &mut self.scratch_s);
         for mac in &self.lines {
             let range = mac.base..mac.base + mac.len;
@@ -76,15 +90,57 @@ impl Macros {
             chain_links(x, xp, f, s, args[mac.slots.k], args[mac.slots.z]);
             stiffness_links(x, f, args[mac.slots.k2]);
         }
-        for mac in &self.meshes {
+        for mac in &mut self.meshes {
             let n = mac.length * mac.width;
             let range = mac.base..mac.base + n;
             let x = &mut p.x[range.clone()];
             let xp = &mut p.xp[range.clone()];
             let f = &mut p.f[range];
-            crate::kernels::mesh::mesh_step(mac, x, xp, f, v, s, args);
+            if n >= ROW_SWEEP_NODES {
+                let ext = take_spread_forces(mac, proxies, f, &mut self.scratch_ext);
+                mesh_step_rows(mac, x, xp, s, ext, args);
+            } else {
+                mesh_step_passes(mac, x, xp, f, v, s, args);
+            }
         }
     }
+}
+
+/// The forces stage 5 spread onto mesh `mac`'s nodes, as (local node, force) in ascending
+/// order, each node once; their slots in F are cleared. Connection points are the only
+/// elements that write onto a macro's nodes (spec §2.8). `ext` has room for four nodes per
+/// connection point (a length, not a capacity: a cloned engine keeps it).
+#[inline(always)]
+fn take_spread_forces<'a>(
+    mac: &MeshMacro,
+    proxies: &Proxies,
+    f: &mut [f64],
+    ext: &'a mut [(u32, f64)],
+) -> &'a [(u32, f64)] {
+    let base = mac.base as u32;
+    let mut len = 0;
+    for (nodes, &(first, _, _)) in proxies.nodes.iter().zip(&proxies.geometry) {
+        if first == base {
+            for &n in nodes {
+                ext[len] = (n - base, 0.0);
+                len += 1;
+            }
+        }
+    }
+    let ext = &mut ext[..len];
+    ext.sort_unstable_by_key(|e| e.0);
+    let mut unique = 0;
+    for i in 0..len {
+        if i == 0 || ext[i].0 != ext[unique - 1].0 {
+            ext[unique] = ext[i];
+            unique += 1;
+        }
+    }
+    let ext = &mut ext[..unique];
+    for e in ext.iter_mut() {
+        e.1 = std::mem::take(&mut f[e.0 as usize]);
+    }
+    ext
 }
 
 /// Moves the nodes of a line macro with the node law; fixed ends keep x = x̃ = X₀. The node
@@ -144,5 +200,45 @@ fn stiffness_links(x: &[f64], f: &mut [f64], k2: f64) {
         let t = k2 * (x[a] - x[b]);
         f[a] -= t;
         f[b] += t;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The spread forces of a large mesh come out sorted, each node once with its whole force,
+    /// their slots cleared; a connection point on another macro is left alone.
+    #[test]
+    fn spread_forces_are_taken_once_per_node() {
+        let mac = MeshMacro {
+            base: 10,
+            length: 3,
+            width: 4,
+            pinned: vec![],
+            slots: MacroSlots::default(),
+            last_kz: (0.0, 0.0),
+        };
+        let proxies = Proxies {
+            nodes: vec![[16, 17, 20, 21], [0, 1, 0, 0], [15, 16, 19, 20]],
+            geometry: vec![(10, 3, 4), (0, 5, 0), (10, 3, 4)],
+            ..Default::default()
+        };
+        let mut f: Vec<f64> = (0..12).map(|i| i as f64 + 0.5).collect();
+        let mut ext = vec![(0, 0.0); 12];
+        let taken = take_spread_forces(&mac, &proxies, &mut f, &mut ext).to_vec();
+        assert_eq!(
+            taken,
+            [
+                (5, 5.5),
+                (6, 6.5),
+                (7, 7.5),
+                (9, 9.5),
+                (10, 10.5),
+                (11, 11.5)
+            ]
+        );
+        let cleared: Vec<usize> = (0..12).filter(|&i| f[i] == 0.0).collect();
+        assert_eq!(cleared, [5, 6, 7, 9, 10, 11]);
     }
 }

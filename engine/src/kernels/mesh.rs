@@ -1,37 +1,17 @@
 //! The mesh macro's kernel (spec §2.7.4): the node law on every node, then spring-dampers
 //! along the width and along the length, in the script's order.
 //!
-//! Two schedules of the same arithmetic, bit for bit: pass by pass over the whole mesh (six
-//! contiguous loops, best while the mesh fits in cache), and one sweep row by row (each row
-//! touched once while it is in cache, best for the large plates). [`mesh_step`] picks by size;
-//! a test runs both on the same state and compares every bit.
+//! Two schedules of the same arithmetic: pass by pass over the whole mesh (six contiguous
+//! loops, best while the mesh fits in cache), and one sweep row by row that keeps no force
+//! array (best for the large plates). [`Macros::step`](super::macros::Macros::step) picks by
+//! size; a test runs both from the same state and compares the positions bit for bit.
 
 use crate::engine::{node_law, MeshMacro};
 use crate::laws;
 
-/// Meshes with at least this many nodes run row by row: from there the six passes stream
-/// more than the caches hold (measured: the 150 × 150 plate 6 % faster by rows, the 25 × 20
-/// mesh 7 % slower).
+/// Meshes with at least this many nodes run row by row ([`mesh_step_rows`]): from there the
+/// six passes stream more than the caches hold.
 pub(crate) const ROW_SWEEP_NODES: usize = 4096;
-
-/// One sample of a mesh: X[n+1] for every node, then the forces of its links (assigned, not
-/// accumulated: F is consumed by the node law first).
-#[inline(always)]
-pub(crate) fn mesh_step(
-    mac: &MeshMacro,
-    x: &mut [f64],
-    xp: &mut [f64],
-    f: &mut [f64],
-    v: &mut [f64],
-    s: &mut [f64],
-    args: &[f64],
-) {
-    if mac.length * mac.width >= ROW_SWEEP_NODES {
-        mesh_step_rows(mac, x, xp, f, v, s, args);
-    } else {
-        mesh_step_passes(mac, x, xp, f, v, s, args);
-    }
-}
 
 /// Pass by pass: every node moves with the node law; pinned nodes are then reset to
 /// x = x̃ = x_edge (node 0's position before the update); then the links (i,j)–(i,j+1) for all
@@ -96,86 +76,193 @@ pub(crate) fn mesh_step_passes(
     }
 }
 
-/// Row by row (see the module documentation).
+/// Row by row, for the large plates: one sweep that touches each row once while it is in
+/// cache, and keeps no force array. The forces the links of sample n would have left in F
+/// (spec §1.5 stage 4, with K and Z as they were at sample n, kept in
+/// [`MeshMacro::last_kz`]) are the same sums of the same terms at the start of sample n + 1,
+/// from x and x̃ as sample n left them; so the sweep computes them there, row by row, and
+/// moves each row as soon as its forces are complete:
+///
+///   F_ij = ((s_i,j−1 − s_i,j) + s_i−1,j) − s_i,j      (row links, then the link from the row
+///                                                       above, then the one to the row below)
+///   s = K·(x_a − x_b) + Z·((x_a − x̃_a) − (x_b − x̃_b))
+///   X_ij[n+1] = (2 − Zo/M)·X_ij + (Zo/M − 1)·X̃_ij + (F_ij + F_ext,ij)/M
+///
+/// so each force is the sum `mesh_step_passes` assigns, in the same order, and the positions
+/// are bit-identical to it. Only the connection points (spec §2.8) write forces onto a mesh's
+/// nodes, and the sweep reads and clears those (`ext`: local node and force, ascending).
+/// F therefore holds no internal force of the mesh between samples. The cost: about half
+/// of the pass-by-pass kernel's loads and stores, and a third less traffic to the L2 cache.
 #[inline(always)]
 pub(crate) fn mesh_step_rows(
-    mac: &MeshMacro,
+    mac: &mut MeshMacro,
     x: &mut [f64],
     xp: &mut [f64],
-    f: &mut [f64],
-    v: &mut [f64],
-    s: &mut [f64],
+    scratch: &mut [f64],
+    ext: &[(u32, f64)],
     args: &[f64],
 ) {
     let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
-    let (k, z) = (args[mac.slots.k], args[mac.slots.z]);
+    let (k, z) = mac.last_kz;
+    mac.last_kz = (args[mac.slots.k], args[mac.slots.z]);
     let (len, w) = (mac.length, mac.width);
+    let (s, rest) = scratch.split_at_mut(w);
+    let (up, rest) = rest.split_at_mut(w);
+    let fbuf = &mut rest[..w];
+    let law = NodeLaw { a, b, inv_m, k, z };
     let x_edge = x[0];
-    let mut pin = 0;
-    // One sweep, row by row, while the rows are in cache: the node law on row r with its
-    // velocities (a ring of two rows), its pinned nodes, its links along the width, then its
-    // forces: row r's own links' (−s_j after +s_{j−1}, as the pass-by-pass kernel assigns
-    // them) plus the link from row r − 1, whose node receives −s after +s from above. Each
-    // force is the same sum in the same order as in the script, so the result is bit-identical
-    // to `mesh_step_passes`; fusing the velocity into the node law (x' − x is the x − x̃ taken
-    // after it) and the two force passes into one saves two passes over the row.
+    let (mut pin, mut e) = (0, 0);
     for row in 0..len {
         let r = row * w;
-        let (v_even, v_odd) = v[..2 * w].split_at_mut(w);
-        let (vc, vp) = if row % 2 == 0 {
-            (v_even, &*v_odd)
+        let first_ext = e;
+        while e < ext.len() && (ext[e].0 as usize) < r + w {
+            e += 1;
+        }
+        let ext_row = &ext[first_ext..e];
+        if row > 0 && row + 1 < len && ext_row.is_empty() {
+            inner_row(&law, w, r, x, xp, up);
         } else {
-            (v_odd, &*v_even)
-        };
-        {
-            let (xr, xpr, fr) = (&mut x[r..r + w], &mut xp[r..r + w], &f[r..r + w]);
-            let nodes = xr.iter_mut().zip(xpr.iter_mut());
-            for ((xj, xpj), (fj, vj)) in nodes.zip(fr.iter().zip(vc.iter_mut())) {
-                let old = *xj;
-                let next = a * old + b * *xpj + fj * inv_m;
-                *xpj = old;
-                *xj = next;
-                *vj = next - old;
-            }
+            any_row(&law, w, r, len, x, xp, s, up, fbuf, ext_row);
         }
         while let Some(&p) = mac.pinned.get(pin).filter(|&&p| (p as usize) < r + w) {
             x[p as usize] = x_edge;
             xp[p as usize] = x_edge;
-            // The velocity as `mesh_step_passes` takes it, after the pin.
-            vc[p as usize - r] = x[p as usize] - xp[p as usize];
             pin += 1;
         }
-        let xr = &x[r..r + w];
-        let sr = &mut s[..w - 1];
-        for j in 0..w - 1 {
-            sr[j] = laws::spring_damper(xr[j] - xr[j + 1], vc[j] - vc[j + 1], k, z);
+    }
+}
+
+/// The coefficients of one sample of the row sweep.
+struct NodeLaw {
+    a: f64,
+    b: f64,
+    inv_m: f64,
+    k: f64,
+    z: f64,
+}
+
+/// The links along row `r..r + w`, from the state at the start of the sample: s_j between
+/// nodes j and j + 1.
+#[inline(always)]
+fn row_links(law: &NodeLaw, x: &[f64], xp: &[f64], s: &mut [f64]) {
+    let w = x.len();
+    let s = &mut s[..w - 1];
+    let (k, z) = (law.k, law.z);
+    for j in 0..w - 1 {
+        let dv = (x[j] - xp[j]) - (x[j + 1] - xp[j + 1]);
+        s[j] = laws::spring_damper(x[j] - x[j + 1], dv, k, z);
+    }
+}
+
+/// A row with rows above and below it and no connection point on it: the forces and the node
+/// law in one loop. Each node reads its right neighbour's old state before that neighbour
+/// moves, and hands its row link to the next node (s_j−1 on the left of node j).
+#[inline(always)]
+fn inner_row(law: &NodeLaw, w: usize, r: usize, x: &mut [f64], xp: &mut [f64], up: &mut [f64]) {
+    let (x_to, x_below) = x.split_at_mut(r + w);
+    let (xp_to, xp_below) = xp.split_at_mut(r + w);
+    inner_nodes(
+        law,
+        &mut x_to[r..],
+        &mut xp_to[r..],
+        &x_below[..w],
+        &xp_below[..w],
+        &mut up[..w],
+    );
+}
+
+/// [`inner_row`]'s loop. The rows are separate arguments so that the compiler knows they do
+/// not overlap, and vectorises it.
+#[inline(always)]
+fn inner_nodes(
+    law: &NodeLaw,
+    xr: &mut [f64],
+    xpr: &mut [f64],
+    xb: &[f64],
+    xpb: &[f64],
+    up: &mut [f64],
+) {
+    let w = xr.len();
+    let (xpr, xb, xpb, up) = (&mut xpr[..w], &xb[..w], &xpb[..w], &mut up[..w]);
+    let NodeLaw { a, b, inv_m, k, z } = *law;
+    let link = |xa: f64, xpa: f64, xb: f64, xpb: f64| {
+        laws::spring_damper(xa - xb, (xa - xpa) - (xb - xpb), k, z)
+    };
+    // Node 0: −s_0, then the links above and below.
+    let mut s_left = link(xr[0], xpr[0], xr[1], xpr[1]);
+    {
+        let (xj, xpj) = (xr[0], xpr[0]);
+        let sv = link(xj, xpj, xb[0], xpb[0]);
+        let fj = (-s_left + up[0]) - sv;
+        up[0] = sv;
+        xr[0] = a * xj + b * xpj + fj * inv_m;
+        xpr[0] = xj;
+    }
+    for j in 1..w - 1 {
+        let (xj, xpj) = (xr[j], xpr[j]);
+        let s_right = link(xj, xpj, xr[j + 1], xpr[j + 1]);
+        let sv = link(xj, xpj, xb[j], xpb[j]);
+        let fj = ((s_left - s_right) + up[j]) - sv;
+        s_left = s_right;
+        up[j] = sv;
+        xr[j] = a * xj + b * xpj + fj * inv_m;
+        xpr[j] = xj;
+    }
+    // Node W − 1: s_W−2, then the links above and below.
+    let j = w - 1;
+    let (xj, xpj) = (xr[j], xpr[j]);
+    let sv = link(xj, xpj, xb[j], xpb[j]);
+    let fj = (s_left + up[j]) - sv;
+    up[j] = sv;
+    xr[j] = a * xj + b * xpj + fj * inv_m;
+    xpr[j] = xj;
+}
+
+/// Any row: the first and the last (no link above or below) and rows with connection points.
+/// The forces go through `fbuf`, in the same order as [`inner_row`] sums them.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn any_row(
+    law: &NodeLaw,
+    w: usize,
+    r: usize,
+    len: usize,
+    x: &mut [f64],
+    xp: &mut [f64],
+    s: &mut [f64],
+    up: &mut [f64],
+    fbuf: &mut [f64],
+    ext_row: &[(u32, f64)],
+) {
+    let NodeLaw { a, b, inv_m, k, z } = *law;
+    let (xr, xpr) = (&x[r..r + w], &xp[r..r + w]);
+    row_links(law, xr, xpr, s);
+    fbuf[0] = -s[0];
+    for j in 1..w - 1 {
+        fbuf[j] = s[j - 1] - s[j];
+    }
+    fbuf[w - 1] = s[w - 2];
+    if r > 0 {
+        for j in 0..w {
+            fbuf[j] += up[j];
         }
-        let sr = &*sr;
-        // Row r's own forces, as `mesh_step_passes` assigns them before the links from the row
-        // above add to them (macros have both sizes ≥ 2): −s_0, s_{j−1} − s_j, s_{W−2}.
-        if row == 0 {
-            let fr = &mut f[..w];
-            fr[0] = -sr[0];
-            for j in 1..w - 1 {
-                fr[j] = sr[j - 1] - sr[j];
-            }
-            fr[w - 1] = sr[w - 2];
-        } else {
-            let (above, here) = f[r - w..r + w].split_at_mut(w);
-            let xu = &x[r - w..r];
-            let link = |j: usize| laws::spring_damper(xu[j] - xr[j], vp[j] - vc[j], k, z);
-            let sv = link(0);
-            above[0] -= sv;
-            here[0] = -sr[0] + sv;
-            for j in 1..w - 1 {
-                let sv = link(j);
-                above[j] -= sv;
-                here[j] = (sr[j - 1] - sr[j]) + sv;
-            }
-            let sv = link(w - 1);
-            above[w - 1] -= sv;
-            here[w - 1] = sr[w - 2] + sv;
+    }
+    if r + w < len * w {
+        let (xb, xpb) = (&x[r + w..r + 2 * w], &xp[r + w..r + 2 * w]);
+        for j in 0..w {
+            let sv = laws::spring_damper(xr[j] - xb[j], (xr[j] - xpr[j]) - (xb[j] - xpb[j]), k, z);
+            fbuf[j] -= sv;
+            up[j] = sv;
         }
+    }
+    for &(node, fe) in ext_row {
+        fbuf[node as usize - r] += fe;
+    }
+    let (xr, xpr) = (&mut x[r..r + w], &mut xp[r..r + w]);
+    for j in 0..w {
+        let xj = xr[j];
+        xr[j] = a * xj + b * xpr[j] + fbuf[j] * inv_m;
+        xpr[j] = xj;
     }
 }
 
@@ -186,10 +273,11 @@ mod tests {
 
     /// Both schedules, from the same irregular state, agree bit for bit for 50 samples, on a
     /// free mesh, a corner-pinned one and a closed one, of several shapes (macros have both
-    /// sizes ≥ 2).
+    /// sizes ≥ 2), with forces spread onto some nodes between samples (stage 5) and K and Z
+    /// changing.
     #[test]
     fn rows_and_passes_are_bit_identical() {
-        for (len, w) in [(7, 5), (2, 2), (5, 3), (3, 9), (9, 2)] {
+        for (len, w) in [(7, 5), (2, 2), (5, 3), (3, 9), (9, 2), (2, 7)] {
             mesh_schedules_agree(len, w);
         }
     }
@@ -208,7 +296,7 @@ mod tests {
             c
         };
         for pinned in [vec![], corners, closed] {
-            let mac = MeshMacro {
+            let mut mac = MeshMacro {
                 base: 0,
                 length: len,
                 width: w,
@@ -220,25 +308,40 @@ mod tests {
                     z: 3,
                     zo: 4,
                 },
+                last_kz: (0.0, 0.0),
             };
-            let args = [1.3, 0.21, 0.0, 0.013, 0.002];
             let start = |seed: f64| -> Vec<f64> {
                 (0..n)
                     .map(|i| ((i as f64 + 1.0) * seed).sin() * 0.1)
                     .collect()
             };
-            let (mut x1, mut xp1, mut f1) = (start(0.7), start(1.3), start(2.1));
-            let (mut x2, mut xp2, mut f2) = (x1.clone(), xp1.clone(), f1.clone());
+            // The pass-by-pass kernel keeps its forces in F; the sweep starts as stage 0
+            // leaves it, with no force.
+            let (mut x1, mut xp1, mut f1) = (start(0.7), start(1.3), vec![0.0; n]);
+            let (mut x2, mut xp2) = (x1.clone(), xp1.clone());
             let (mut v1, mut s1) = (vec![0.0; n], vec![0.0; n]);
-            let (mut v2, mut s2) = (vec![0.0; n], vec![0.0; n]);
-            for _ in 0..50 {
+            let mut scratch = vec![0.0; 3 * w];
+            let mut diverged = false;
+            for step in 0..50 {
+                let args = [1.3, 0.21 + 0.01 * (step % 3) as f64, 0.0, 0.013, 0.002];
+                // Forces on a node in the first row, one inside, one in the last row.
+                let ext: Vec<(u32, f64)> = [1, n / 2, n - 1]
+                    .iter()
+                    .map(|&i| (i as u32, 0.01 * (step as f64 * 0.37 + i as f64).sin()))
+                    .collect::<std::collections::BTreeMap<_, _>>()
+                    .into_iter()
+                    .collect();
+                for &(i, fe) in &ext {
+                    f1[i as usize] += fe;
+                }
                 mesh_step_passes(&mac, &mut x1, &mut xp1, &mut f1, &mut v1, &mut s1, &args);
-                mesh_step_rows(&mac, &mut x2, &mut xp2, &mut f2, &mut v2, &mut s2, &args);
+                mesh_step_rows(&mut mac, &mut x2, &mut xp2, &mut scratch, &ext, &args);
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-                assert_eq!(bits(&x1), bits(&x2));
-                assert_eq!(bits(&xp1), bits(&xp2));
-                assert_eq!(bits(&f1), bits(&f2));
+                assert_eq!(bits(&x1), bits(&x2), "{len}×{w}, sample {step}");
+                assert_eq!(bits(&xp1), bits(&xp2), "{len}×{w}, sample {step}");
+                diverged |= x1 != start(0.7);
             }
+            assert!(diverged);
         }
     }
 }
