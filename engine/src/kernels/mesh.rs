@@ -108,7 +108,11 @@ pub(crate) fn mesh_step_rows(
     let (len, w) = (mac.length, mac.width);
     let (s, rest) = scratch.split_at_mut(w);
     let (up, rest) = rest.split_at_mut(w);
-    let fbuf = &mut rest[..w];
+    let (fbuf, rest) = rest.split_at_mut(w);
+    // Velocities x − x̃ at the start of the sample: row r's, and row r + 1's, which row r
+    // computes for its links below and hands on.
+    let (v_even, rest) = rest.split_at_mut(w);
+    let v_odd = &mut rest[..w];
     let law = NodeLaw { a, b, inv_m, k, z };
     let x_edge = x[0];
     let (mut pin, mut e) = (0, 0);
@@ -119,10 +123,15 @@ pub(crate) fn mesh_step_rows(
             e += 1;
         }
         let ext_row = &ext[first_ext..e];
-        if row > 0 && row + 1 < len && ext_row.is_empty() {
-            inner_row(&law, w, r, x, xp, up);
+        let (v_row, v_below) = if row % 2 == 0 {
+            (&*v_even, &mut *v_odd)
         } else {
-            any_row(&law, w, r, len, x, xp, s, up, fbuf, ext_row);
+            (&*v_odd, &mut *v_even)
+        };
+        if row > 0 && row + 1 < len && ext_row.is_empty() {
+            inner_row(&law, w, r, x, xp, up, v_row, v_below);
+        } else {
+            any_row(&law, w, r, len, x, xp, s, up, fbuf, ext_row, v_below);
         }
         while let Some(&p) = mac.pinned.get(pin).filter(|&&p| (p as usize) < r + w) {
             x[p as usize] = x_edge;
@@ -156,65 +165,85 @@ fn row_links(law: &NodeLaw, x: &[f64], xp: &[f64], s: &mut [f64]) {
 
 /// A row with rows above and below it and no connection point on it: the forces and the node
 /// law in one loop. Each node reads its right neighbour's old state before that neighbour
-/// moves, and hands its row link to the next node (s_j−1 on the left of node j).
+/// moves, and hands its row link to the next node (s_j−1 on the left of node j). The row's
+/// velocities come from the row above; the row below's go to the next row.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn inner_row(law: &NodeLaw, w: usize, r: usize, x: &mut [f64], xp: &mut [f64], up: &mut [f64]) {
+fn inner_row(
+    law: &NodeLaw,
+    w: usize,
+    r: usize,
+    x: &mut [f64],
+    xp: &mut [f64],
+    up: &mut [f64],
+    v_row: &[f64],
+    v_below: &mut [f64],
+) {
     let (x_to, x_below) = x.split_at_mut(r + w);
     let (xp_to, xp_below) = xp.split_at_mut(r + w);
     inner_nodes(
         law,
         &mut x_to[r..],
         &mut xp_to[r..],
+        &v_row[..w],
         &x_below[..w],
         &xp_below[..w],
+        &mut v_below[..w],
         &mut up[..w],
     );
 }
 
-/// [`inner_row`]'s loop. The rows are separate arguments so that the compiler knows they do
-/// not overlap, and vectorises it.
+/// [`inner_row`]'s loop. The rows come in as separate arguments so that the compiler knows
+/// they do not overlap, and vectorises it (they lose that inside a struct).
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn inner_nodes(
     law: &NodeLaw,
     xr: &mut [f64],
     xpr: &mut [f64],
+    vr: &[f64],
     xb: &[f64],
     xpb: &[f64],
+    vb_out: &mut [f64],
     up: &mut [f64],
 ) {
     let w = xr.len();
-    let (xpr, xb, xpb, up) = (&mut xpr[..w], &xb[..w], &xpb[..w], &mut up[..w]);
+    let (xpr, vr, xb, xpb) = (&mut xpr[..w], &vr[..w], &xb[..w], &xpb[..w]);
+    let (vb_out, up) = (&mut vb_out[..w], &mut up[..w]);
     let NodeLaw { a, b, inv_m, k, z } = *law;
-    let link = |xa: f64, xpa: f64, xb: f64, xpb: f64| {
-        laws::spring_damper(xa - xb, (xa - xpa) - (xb - xpb), k, z)
-    };
     // Node 0: −s_0, then the links above and below.
-    let mut s_left = link(xr[0], xpr[0], xr[1], xpr[1]);
+    let mut s_left = laws::spring_damper(xr[0] - xr[1], vr[0] - vr[1], k, z);
     {
-        let (xj, xpj) = (xr[0], xpr[0]);
-        let sv = link(xj, xpj, xb[0], xpb[0]);
+        let (xj, vj) = (xr[0], vr[0]);
+        let vbj = xb[0] - xpb[0];
+        vb_out[0] = vbj;
+        let sv = laws::spring_damper(xj - xb[0], vj - vbj, k, z);
         let fj = (-s_left + up[0]) - sv;
         up[0] = sv;
-        xr[0] = a * xj + b * xpj + fj * inv_m;
+        xr[0] = a * xj + b * xpr[0] + fj * inv_m;
         xpr[0] = xj;
     }
     for j in 1..w - 1 {
-        let (xj, xpj) = (xr[j], xpr[j]);
-        let s_right = link(xj, xpj, xr[j + 1], xpr[j + 1]);
-        let sv = link(xj, xpj, xb[j], xpb[j]);
+        let (xj, vj) = (xr[j], vr[j]);
+        let s_right = laws::spring_damper(xj - xr[j + 1], vj - vr[j + 1], k, z);
+        let vbj = xb[j] - xpb[j];
+        vb_out[j] = vbj;
+        let sv = laws::spring_damper(xj - xb[j], vj - vbj, k, z);
         let fj = ((s_left - s_right) + up[j]) - sv;
         s_left = s_right;
         up[j] = sv;
-        xr[j] = a * xj + b * xpj + fj * inv_m;
+        xr[j] = a * xj + b * xpr[j] + fj * inv_m;
         xpr[j] = xj;
     }
     // Node W − 1: s_W−2, then the links above and below.
     let j = w - 1;
-    let (xj, xpj) = (xr[j], xpr[j]);
-    let sv = link(xj, xpj, xb[j], xpb[j]);
+    let (xj, vj) = (xr[j], vr[j]);
+    let vbj = xb[j] - xpb[j];
+    vb_out[j] = vbj;
+    let sv = laws::spring_damper(xj - xb[j], vj - vbj, k, z);
     let fj = (s_left + up[j]) - sv;
     up[j] = sv;
-    xr[j] = a * xj + b * xpj + fj * inv_m;
+    xr[j] = a * xj + b * xpr[j] + fj * inv_m;
     xpr[j] = xj;
 }
 
@@ -233,6 +262,7 @@ fn any_row(
     up: &mut [f64],
     fbuf: &mut [f64],
     ext_row: &[(u32, f64)],
+    v_below: &mut [f64],
 ) {
     let NodeLaw { a, b, inv_m, k, z } = *law;
     let (xr, xpr) = (&x[r..r + w], &xp[r..r + w]);
@@ -250,7 +280,9 @@ fn any_row(
     if r + w < len * w {
         let (xb, xpb) = (&x[r + w..r + 2 * w], &xp[r + w..r + 2 * w]);
         for j in 0..w {
-            let sv = laws::spring_damper(xr[j] - xb[j], (xr[j] - xpr[j]) - (xb[j] - xpb[j]), k, z);
+            let vb = xb[j] - xpb[j];
+            v_below[j] = vb;
+            let sv = laws::spring_damper(xr[j] - xb[j], (xr[j] - xpr[j]) - vb, k, z);
             fbuf[j] -= sv;
             up[j] = sv;
         }
@@ -320,7 +352,7 @@ mod tests {
             let (mut x1, mut xp1, mut f1) = (start(0.7), start(1.3), vec![0.0; n]);
             let (mut x2, mut xp2) = (x1.clone(), xp1.clone());
             let (mut v1, mut s1) = (vec![0.0; n], vec![0.0; n]);
-            let mut scratch = vec![0.0; 3 * w];
+            let mut scratch = vec![0.0; 5 * w];
             let mut diverged = false;
             for step in 0..50 {
                 let args = [1.3, 0.21 + 0.01 * (step % 3) as f64, 0.0, 0.013, 0.002];
