@@ -116,24 +116,38 @@ pub(crate) fn mesh_step_rows(
     let law = NodeLaw { a, b, inv_m, k, z };
     let x_edge = x[0];
     let (mut pin, mut e) = (0, 0);
-    for row in 0..len {
+    // Which ring holds the velocities of the next row to move.
+    let mut v_in_even = true;
+    let mut row = 0;
+    while row < len {
         let r = row * w;
         let first_ext = e;
         while e < ext.len() && (ext[e].0 as usize) < r + w {
             e += 1;
         }
         let ext_row = &ext[first_ext..e];
-        let (v_row, v_below) = if row % 2 == 0 {
+        let (v_row, v_next) = if v_in_even {
             (&*v_even, &mut *v_odd)
         } else {
             (&*v_odd, &mut *v_even)
         };
-        if row > 0 && row + 1 < len && ext_row.is_empty() {
-            inner_row(&law, w, r, x, xp, up, v_row, v_below);
+        v_in_even = !v_in_even;
+        let pair = row > 0
+            && row + 2 < len
+            && ext_row.is_empty()
+            && ext.get(e).is_none_or(|&(n, _)| n as usize >= r + 2 * w);
+        if pair {
+            inner_pair(&law, w, r, x, xp, up, v_row, v_next);
+            row += 2;
+        } else if row > 0 && row + 1 < len && ext_row.is_empty() {
+            inner_row(&law, w, r, x, xp, up, v_row, v_next);
+            row += 1;
         } else {
-            any_row(&law, w, r, len, x, xp, s, up, fbuf, ext_row, v_below);
+            any_row(&law, w, r, len, x, xp, s, up, fbuf, ext_row, v_next);
+            row += 1;
         }
-        while let Some(&p) = mac.pinned.get(pin).filter(|&&p| (p as usize) < r + w) {
+        let done = row * w;
+        while let Some(&p) = mac.pinned.get(pin).filter(|&&p| (p as usize) < done) {
             x[p as usize] = x_edge;
             xp[p as usize] = x_edge;
             pin += 1;
@@ -245,6 +259,115 @@ fn inner_nodes(
     up[j] = sv;
     xr[j] = a * xj + b * xpr[j] + fj * inv_m;
     xpr[j] = xj;
+}
+
+/// Two rows with rows above and below them and no connection point on them, in one loop:
+/// the link between them is computed once and used by both, and neither's velocities nor
+/// that link's force go through memory. Row r's velocities come from the row above; row
+/// r + 2's go to the next row. The same sums in the same order as [`inner_row`] twice.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn inner_pair(
+    law: &NodeLaw,
+    w: usize,
+    r: usize,
+    x: &mut [f64],
+    xp: &mut [f64],
+    up: &mut [f64],
+    v_row: &[f64],
+    v_next: &mut [f64],
+) {
+    let (x0, rest) = x[r..].split_at_mut(w);
+    let (x1, rest) = rest.split_at_mut(w);
+    let (xp0, xp_rest) = xp[r..].split_at_mut(w);
+    let (xp1, xp_rest) = xp_rest.split_at_mut(w);
+    pair_nodes(
+        law,
+        x0,
+        xp0,
+        x1,
+        xp1,
+        &v_row[..w],
+        &rest[..w],
+        &xp_rest[..w],
+        &mut v_next[..w],
+        &mut up[..w],
+    );
+}
+
+/// [`inner_pair`]'s loop, each row its own argument for the vectoriser (see
+/// [`inner_nodes`]; in an array they lose their no-alias facts too).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn pair_nodes(
+    law: &NodeLaw,
+    x0: &mut [f64],
+    xp0: &mut [f64],
+    x1: &mut [f64],
+    xp1: &mut [f64],
+    v0: &[f64],
+    x2: &[f64],
+    xp2: &[f64],
+    v2_out: &mut [f64],
+    up: &mut [f64],
+) {
+    let w = x0.len();
+    let (xp0, x1, xp1, v0) = (&mut xp0[..w], &mut x1[..w], &mut xp1[..w], &v0[..w]);
+    let (x2, xp2, v2_out, up) = (&x2[..w], &xp2[..w], &mut v2_out[..w], &mut up[..w]);
+    let NodeLaw { a, b, inv_m, k, z } = *law;
+    let link = |dx: f64, dv: f64| laws::spring_damper(dx, dv, k, z);
+    let mut s0_left = link(x0[0] - x0[1], v0[0] - v0[1]);
+    let mut s1_left = link(x1[0] - x1[1], (x1[0] - xp1[0]) - (x1[1] - xp1[1]));
+    // Node 0 of both rows: −s_0, then the links above and below.
+    {
+        let (x0j, v0j, x1j) = (x0[0], v0[0], x1[0]);
+        let v1j = x1j - xp1[0];
+        let v2j = x2[0] - xp2[0];
+        v2_out[0] = v2j;
+        let s01 = link(x0j - x1j, v0j - v1j);
+        let s12 = link(x1j - x2[0], v1j - v2j);
+        let f0 = (-s0_left + up[0]) - s01;
+        let f1 = (-s1_left + s01) - s12;
+        up[0] = s12;
+        x0[0] = a * x0j + b * xp0[0] + f0 * inv_m;
+        xp0[0] = x0j;
+        x1[0] = a * x1j + b * xp1[0] + f1 * inv_m;
+        xp1[0] = x1j;
+    }
+    for j in 1..w - 1 {
+        let (x0j, v0j, x1j) = (x0[j], v0[j], x1[j]);
+        let s0_right = link(x0j - x0[j + 1], v0j - v0[j + 1]);
+        let v1j = x1j - xp1[j];
+        let s1_right = link(x1j - x1[j + 1], v1j - (x1[j + 1] - xp1[j + 1]));
+        let v2j = x2[j] - xp2[j];
+        v2_out[j] = v2j;
+        let s01 = link(x0j - x1j, v0j - v1j);
+        let s12 = link(x1j - x2[j], v1j - v2j);
+        let f0 = ((s0_left - s0_right) + up[j]) - s01;
+        let f1 = ((s1_left - s1_right) + s01) - s12;
+        s0_left = s0_right;
+        s1_left = s1_right;
+        up[j] = s12;
+        x0[j] = a * x0j + b * xp0[j] + f0 * inv_m;
+        xp0[j] = x0j;
+        x1[j] = a * x1j + b * xp1[j] + f1 * inv_m;
+        xp1[j] = x1j;
+    }
+    // Node W − 1 of both rows: s_W−2, then the links above and below.
+    let j = w - 1;
+    let (x0j, v0j, x1j) = (x0[j], v0[j], x1[j]);
+    let v1j = x1j - xp1[j];
+    let v2j = x2[j] - xp2[j];
+    v2_out[j] = v2j;
+    let s01 = link(x0j - x1j, v0j - v1j);
+    let s12 = link(x1j - x2[j], v1j - v2j);
+    let f0 = (s0_left + up[j]) - s01;
+    let f1 = (s1_left + s01) - s12;
+    up[j] = s12;
+    x0[j] = a * x0j + b * xp0[j] + f0 * inv_m;
+    xp0[j] = x0j;
+    x1[j] = a * x1j + b * xp1[j] + f1 * inv_m;
+    xp1[j] = x1j;
 }
 
 /// Any row: the first and the last (no link above or below) and rows with connection points.
