@@ -208,7 +208,9 @@ fn inner_row(
 }
 
 /// [`inner_row`]'s loop. The rows come in as separate arguments so that the compiler knows
-/// they do not overlap, and vectorises it (they lose that inside a struct).
+/// they do not overlap, and vectorises it (they lose that inside a struct). The first and
+/// last nodes repeat the loop's body on purpose: with the body in a helper function shared
+/// by all three, the loop no longer vectorised (the plate took 66 µs instead of 23).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn inner_nodes(
