@@ -49,6 +49,9 @@ pub struct CompileOptions {
     pub sample_rate_hz: f64,
     /// The motion refresh interval R in samples (spec §6.1), ≥ 1.
     pub motion_interval: u32,
+    /// Whether a small model's sample loop is also compiled to machine code ([`crate::jit`]:
+    /// the same samples, faster). On by default; off runs every model on the interpreter.
+    pub jit: bool,
 }
 
 impl Default for CompileOptions {
@@ -56,6 +59,7 @@ impl Default for CompileOptions {
         CompileOptions {
             sample_rate_hz: REFERENCE_SAMPLE_RATE_HZ,
             motion_interval: DEFAULT_MOTION_INTERVAL_SAMPLES,
+            jit: true,
         }
     }
 }

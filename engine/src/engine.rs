@@ -22,6 +22,7 @@ pub use crate::display::{IoKind, IoPoint};
 use crate::expr::{ExprRef, Program};
 pub use crate::guard::{GuardEvent, GuardKind};
 use crate::info::ModelInfo;
+use crate::jit::NativeCode;
 pub(crate) use crate::kernels::masses::{single_law, SingleMasses};
 use crate::motion::MotionStore;
 pub(crate) use crate::rest::Rest;
@@ -187,6 +188,12 @@ pub struct Engine {
     /// picks the best the CPU has. Without FMA contraction all give the same IEEE operations,
     /// so the same samples.
     pub(crate) arch: pulp::Arch,
+    /// The sample loop compiled to machine code, for small models ([`crate::jit`]); shared
+    /// by the engine's copies.
+    pub(crate) native: Option<Arc<NativeCode>>,
+    /// Whether `native` runs the model as it stands ([`NativeCode::fits`]): updated with the
+    /// coefficients at every control change.
+    pub(crate) native_fits: bool,
 }
 
 /// One block of [`Engine::process`] as a pulp operation: `with_simd` is inlined into the
@@ -217,6 +224,23 @@ impl pulp::WithSimd for Block<'_> {
             self.out_channels,
         )
     }
+}
+
+/// Whether every input sample reads as +0: +0 itself, or a non-finite value (read as 0).
+/// On 32-bit halves and without a short circuit within 64 samples, so that it vectorises on
+/// plain x86-64 (SSE2 has no 64-bit compare): a tiny model's whole block costs little more
+/// than a scalar scan of its input.
+pub(crate) fn silent(inputs: &[f64]) -> bool {
+    inputs.chunks(64).all(|chunk| {
+        let mut loud = 0u32;
+        for v in chunk {
+            let bits = v.to_bits();
+            let (hi, lo) = ((bits >> 32) as u32, bits as u32);
+            // Finite (the exponent is not all ones) and not +0.
+            loud |= ((hi & 0x7ff0_0000 != 0x7ff0_0000) & ((hi | lo) != 0)) as u32;
+        }
+        loud == 0
+    })
 }
 
 /// An error setting a parameter.
@@ -496,6 +520,9 @@ impl Engine {
         if matches!(changed, Changed::All | Changed::Some { values: true, .. }) {
             self.interactions.find_uniform(self.control.raw());
         }
+        self.native_fits = self.native.as_ref().is_some_and(|code| code.fits(self));
+        // New coefficients end a fixed point (`rest.rs`), whichever call applied them.
+        self.rest = Rest::Moving;
         self.params_dirty = false;
     }
 
@@ -530,22 +557,29 @@ impl Engine {
         outputs[..out_channels * frames].fill(0.0);
         if self.params_dirty {
             self.refresh_control();
-            self.rest = Rest::Moving;
         }
         let was_tripped = self.guard.is_some();
         let mut simulated = 0;
         if !was_tripped {
-            // Silent: every input sample reads as +0 (non-finite ones count as 0), and no
-            // motion store wants the frames written.
-            let silent = self.motion.is_none()
-                && inputs[..in_channels * frames]
-                    .iter()
-                    .all(|v| v.to_bits() == 0 || !v.is_finite());
-            if !silent {
+            // Quiet: every input sample reads as +0 (non-finite ones count as 0), and no
+            // motion store wants the frames written. Asked only of a model at rest or
+            // coming to rest: the scan costs a tiny model as much as its samples.
+            let quiet = |e: &Engine| e.motion.is_none() && silent(&inputs[..in_channels * frames]);
+            if self.rest != Rest::Moving && !quiet(self) {
                 self.rest = Rest::Moving;
             }
             let arch = self.arch;
             let block = |engine: &mut Engine, outputs: &mut [f64], start: usize, end: usize| {
+                if engine.native_fits && engine.motion.is_none() {
+                    return engine.run_native(
+                        start..end,
+                        frames,
+                        inputs,
+                        in_channels,
+                        outputs,
+                        out_channels,
+                    );
+                }
                 arch.dispatch(Block {
                     engine,
                     start,
@@ -573,7 +607,7 @@ impl Engine {
                     self.hold(start, frames, outputs, out_channels)
                 } else {
                     let n = block(self, outputs, start, frames);
-                    if silent && self.guard.is_none() && self.stationary() {
+                    if self.guard.is_none() && self.stationary() && quiet(self) {
                         self.rest = Rest::Still;
                     }
                     n
@@ -785,7 +819,7 @@ impl Engine {
     /// 0 (a select, not a branch, so that it vectorises). The forces count: stage 4 leaves them
     /// for the next sample's mass update, and a tail flushed without them comes back from them.
     #[inline(always)]
-    fn flush_tiny(&mut self) {
+    pub(crate) fn flush_tiny(&mut self) {
         let p = &mut self.points;
         // One loop per array: a chain of the three does not vectorise.
         for a in [&mut p.x, &mut p.xp, &mut p.f] {

@@ -30,6 +30,7 @@ pub mod generators;
 mod guard;
 pub mod info;
 pub mod instrument;
+mod jit;
 mod kernels;
 pub mod lanes;
 pub mod lang;

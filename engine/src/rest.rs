@@ -89,6 +89,43 @@ mod tests {
     /// as `process` runs it, and with the rest state cleared before every block, so that every
     /// sample is stepped. Outputs, positions, guard events and sample counts are equal bit for
     /// bit, and the first run did hold a fixed point.
+    /// `engine::silent` reads a block as silent exactly when every sample is +0 or not
+    /// finite, wherever the loud sample lies in its 64-sample chunks.
+    #[test]
+    fn silence_is_plus_zero_or_not_finite() {
+        let quiet = [0.0, f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -f64::NAN];
+        let loud = [-0.0, 1e-310, -1e-310, 1.0, f64::MAX, -f64::MIN_POSITIVE];
+        for len in [1, 63, 64, 65, 130] {
+            for at in [0, len / 2, len - 1] {
+                let mut v: Vec<f64> = (0..len).map(|i| quiet[i % quiet.len()]).collect();
+                assert!(crate::engine::silent(&v));
+                for &l in &loud {
+                    v[at] = l;
+                    assert!(!crate::engine::silent(&v), "{l:e} at {at} of {len}");
+                }
+            }
+        }
+        assert!(crate::engine::silent(&[]));
+    }
+
+    /// A change applied before the block (`apply_pending_changes`, as the instrument does)
+    /// ends the hold as a change applied by `process` does: a mass resting on a spring is
+    /// pulled down by a gravity parameter either way.
+    #[test]
+    fn a_change_applied_before_the_block_ends_the_hold() {
+        let spec = parse(MODELS[3]).spec.expect("parses");
+        let mut e = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
+        let mut out = vec![0.0; 64];
+        e.process(64, &[], &mut out);
+        e.process(64, &[], &mut out);
+        assert_eq!(e.rest, Rest::Fixed);
+        let g = e.param_id("G").unwrap();
+        e.set_param(g, 0.001).expect("a finite value");
+        e.apply_pending_changes();
+        e.process(64, &[], &mut out);
+        assert!(out[63] < 0.0, "the mass falls: {}", out[63]);
+    }
+
     #[test]
     fn a_model_at_rest_is_held() {
         for text in MODELS {

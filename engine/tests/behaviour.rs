@@ -390,6 +390,7 @@ fn motion_buffers_are_written_on_the_first_sample_and_every_interval() {
         &CompileOptions {
             sample_rate_hz: 44_100.0,
             motion_interval: 10,
+            ..CompileOptions::default()
         },
     )
     .unwrap();
@@ -430,6 +431,7 @@ fn motion_frames_land_on_their_samples_in_any_block_sizes() {
     let options = CompileOptions {
         sample_rate_hz: 44_100.0,
         motion_interval: 7,
+        ..CompileOptions::default()
     };
     let mut plain = compile(&spec, &options).unwrap();
     let mut watched = plain.clone();

@@ -55,6 +55,7 @@ fn main() {
     let mut passed = 0;
     let mut failed = 0;
     let mut audio_params_set = 0;
+    let mut natives = 0;
     for (name, spec) in reference::all() {
         // A clone, as voices and the plugin run: `clone` keeps lengths, not capacities.
         let mut e = compile(&spec, &CompileOptions::at(48_000.0))
@@ -113,6 +114,44 @@ fn main() {
                  motion frames)"
             );
         }
+        // Without a motion store a small model runs on its native code (engine/src/jit.rs):
+        // the same life again, on that path.
+        drop(e.set_motion_store(None));
+        e.apply_pending_changes();
+        if e.native_code_bytes().is_some() {
+            natives += 1;
+            let (native_blocks, allocations) = counted(|| {
+                let mut native_blocks = 0;
+                for b in 0..blocks {
+                    native_blocks += e.native_code_bytes().is_some() as usize;
+                    e.process(frames, &input, &mut output);
+                    if let Some(id) = param {
+                        let v = e.param(id).unwrap_or(0.0);
+                        let _ = e.set_param(id, v * (1.0 + 1e-3 * b as f64));
+                    }
+                    e.set_class_gain(ScaleClass::Stiffness, 1.0 + 0.01 * b as f64);
+                    e.process(1, &input[..in_ch], &mut output[..out_ch]);
+                }
+                e.reset();
+                e.process(frames, &input, &mut output);
+                native_blocks
+            });
+            if allocations == 0 && native_blocks > 0 {
+                passed += 1;
+                println!("test no_alloc::{name}_native ... ok");
+            } else {
+                failed += 1;
+                println!(
+                    "test no_alloc::{name}_native ... FAILED ({allocations} allocations, \
+                     {native_blocks} native blocks)"
+                );
+            }
+        }
+    }
+    // At least one reference model runs native code, or that path went unchecked.
+    if natives == 0 {
+        println!("test no_alloc::native_code ... FAILED (no model runs native code)");
+        failed += 1;
     }
     // The instrument with a voice bank through a storm of 10,000 notes (stealing, releasing,
     // the sustain pedal, controllers, pitch bend), host input, and a reset: a small model of

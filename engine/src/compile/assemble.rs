@@ -134,8 +134,17 @@ impl<'a> Cx<'a> {
             motion_interval: options.motion_interval.max(1),
             motion_counter: 0,
             arch,
+            native: None,
+            native_fits: false,
         };
         engine.reset();
+        if options.jit {
+            engine.native = crate::jit::NativeCode::build(&engine).map(std::sync::Arc::new);
+            engine.native_fits = engine
+                .native
+                .as_ref()
+                .is_some_and(|code| code.fits(&engine));
+        }
         Ok(engine)
     }
 

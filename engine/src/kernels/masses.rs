@@ -74,7 +74,7 @@ impl SingleMasses {
 
     /// Whether point `i` runs the plain update (bit patterns compared: a −0 gravity is not
     /// plain, since F − (−0) turns a −0 force into +0).
-    fn is_plain(&self, i: usize) -> bool {
+    pub(crate) fn is_plain(&self, i: usize) -> bool {
         !self.audio[i]
             && self.a[i].to_bits() == 2.0f64.to_bits()
             && self.b[i].to_bits() == (-1.0f64).to_bits()
