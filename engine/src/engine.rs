@@ -568,7 +568,6 @@ impl Engine {
             if self.rest != Rest::Moving && !quiet(self) {
                 self.rest = Rest::Moving;
             }
-            let arch = self.arch;
             let block = |engine: &mut Engine, outputs: &mut [f64], start: usize, end: usize| {
                 if engine.native_fits && engine.motion.is_none() {
                     return engine.run_native(
@@ -580,16 +579,14 @@ impl Engine {
                         out_channels,
                     );
                 }
-                arch.dispatch(Block {
-                    engine,
-                    start,
-                    end,
+                engine.run_interpreted(
+                    start..end,
                     frames,
                     inputs,
                     in_channels,
                     outputs,
                     out_channels,
-                })
+                )
             };
             let mut start = 0;
             if self.rest == Rest::Still && frames > 0 {
@@ -621,6 +618,29 @@ impl Engine {
             simulated,
             tripped: !was_tripped && self.guard.is_some(),
         }
+    }
+
+    /// Samples `samples` of a block on the interpreter, with the instruction set of
+    /// `self.arch`. Returns how many samples ran (fewer when the guard trips).
+    pub(crate) fn run_interpreted(
+        &mut self,
+        samples: std::ops::Range<usize>,
+        frames: usize,
+        inputs: &[f64],
+        in_channels: usize,
+        outputs: &mut [f64],
+        out_channels: usize,
+    ) -> usize {
+        self.arch.dispatch(Block {
+            start: samples.start,
+            end: samples.end,
+            engine: self,
+            frames,
+            inputs,
+            in_channels,
+            outputs,
+            out_channels,
+        })
     }
 
     /// The sample loop of [`Engine::process`], inlined into each instruction set's copy.

@@ -48,6 +48,7 @@ use std::sync::{Mutex, OnceLock};
 
 mod emit;
 pub(crate) mod laws;
+mod sample;
 
 /// The most points a model compiled to native code may have. Beyond a few dozen points the
 /// state no longer fits in registers and the interpreter's vector loops win (the 12-point
@@ -76,15 +77,29 @@ pub(crate) struct Frame {
     pub in_channels: usize,
     pub out_channels: usize,
     pub limit: f64,
-    /// One +0, read by every sample of an input channel the block does not have.
+    /// −0: its bits flip a sign.
+    pub sign: f64,
+    /// [`SPARE`] zeros, read by an input channel the block does not have.
     pub zero: *const f64,
-    /// Written by every sample of an output channel the block does not have.
+    /// [`SPARE`] values written by an output channel the block does not have.
     pub sink: *mut f64,
 }
 
-/// The generated function: runs samples `start..end` and returns `end`, or the first sample
-/// whose outputs the guard rejects (its state stored, as after that sample).
+/// The most samples one call of the generated function runs, and the length of the spare
+/// channels (`Frame::zero`, `Frame::sink`).
+pub(crate) const SPARE: usize = FLUSH_INTERVAL as usize;
+
+/// The spare input channel.
+static ZEROS: [f64; SPARE] = [0.0; SPARE];
+
+/// The generated function: runs samples `start..end` and returns `end`; or the first sample
+/// whose outputs the guard rejects (its state stored, as after that sample); or, with
+/// [`BAIL`] set, the first sample whose state the code does not handle (a non-finite input,
+/// ground position or force on a ground, or a ground at −0), its state stored as before it.
 type Entry = unsafe extern "C" fn(*const Frame, i64, i64) -> i64;
+
+/// The flag of a bail-out in the generated function's result.
+pub(crate) const BAIL: i64 = 1 << 62;
 
 /// A model's sample loop as machine code.
 pub(crate) struct NativeCode {
@@ -204,8 +219,7 @@ impl Engine {
         };
         debug_assert!(inputs.len() >= in_channels * frames);
         debug_assert!(outputs.len() >= out_channels * frames && samples.end <= frames);
-        let zero = 0.0f64;
-        let mut sink = 0.0f64;
+        let mut sink = [0.0f64; SPARE];
         let mut n = samples.start;
         while n < samples.end {
             // Calls end where the periodic flush is due.
@@ -226,14 +240,36 @@ impl Engine {
                 in_channels,
                 out_channels,
                 limit: self.position_limit,
-                zero: &zero,
-                sink: &mut sink,
+                sign: -0.0,
+                zero: ZEROS.as_ptr(),
+                sink: sink.as_mut_ptr(),
             };
+            debug_assert!(stop - n <= SPARE);
             // SAFETY: the code was made for this engine's arrays, whose lengths `fits`
             // checked; it reads input channels below `in_channels` and writes output channels
             // below `out_channels`, at samples below `stop` ≤ `frames`, which the caller's
             // buffers hold.
-            let done = unsafe { entry(&frame, n as i64, stop as i64) } as usize;
+            let result = unsafe { entry(&frame, n as i64, stop as i64) };
+            if result & BAIL != 0 {
+                // Samples n … k − 1 ran; sample k runs on the interpreter, which also counts
+                // it, flushes and guards.
+                let k = (result & !BAIL) as usize;
+                self.samples_since_reset += (k - n) as u64;
+                let ran = self.run_interpreted(
+                    k..k + 1,
+                    frames,
+                    inputs,
+                    in_channels,
+                    outputs,
+                    out_channels,
+                );
+                if self.guard.is_some() {
+                    return ran;
+                }
+                n = k + 1;
+                continue;
+            }
+            let done = result as usize;
             if done < stop {
                 // A bad output at sample `done`: the state is as after it.
                 self.samples_since_reset += (done - n) as u64;
