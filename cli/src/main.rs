@@ -149,6 +149,10 @@ struct BenchArgs {
     /// without `--sweep`).
     #[arg(long)]
     sweep: bool,
+    /// Run the model on the interpreter even where it would run on native code (a small
+    /// model's sample loop compiled when it loads), to measure what that code gains.
+    #[arg(long)]
+    no_jit: bool,
 }
 
 /// Why a command failed: bad model (exit 1) or usage / I/O (exit 2). The message is printed
@@ -195,12 +199,17 @@ fn load(path: &Path) -> Result<ModelSpec, Failure> {
 
 /// Compiles a spec, printing compile errors with their location.
 fn build(path: &Path, spec: &ModelSpec, sample_rate_hz: f64) -> Result<Engine, Failure> {
+    build_with(path, spec, &CompileOptions::at(sample_rate_hz))
+}
+
+fn build_with(path: &Path, spec: &ModelSpec, options: &CompileOptions) -> Result<Engine, Failure> {
+    let sample_rate_hz = options.sample_rate_hz;
     if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
         return Err(usage(format!(
             "invalid sample rate {sample_rate_hz}: it must be a positive number of Hz"
         )));
     }
-    compile(spec, &CompileOptions::at(sample_rate_hz)).map_err(|errors| {
+    compile(spec, options).map_err(|errors| {
         for e in &errors.0 {
             report::print_compile_error(path, e);
         }
@@ -552,7 +561,11 @@ fn bench(a: &BenchArgs) -> Result<(), Failure> {
             return Err(Failure::Model);
         }
     };
-    let mut engine = build(&a.model, &spec, a.sample_rate)?;
+    let options = CompileOptions {
+        jit: !a.no_jit,
+        ..CompileOptions::at(a.sample_rate)
+    };
+    let mut engine = build_with(&a.model, &spec, &options)?;
     let compile_ms = start.elapsed().as_secs_f64() * 1e3;
 
     if a.sweep {
@@ -602,9 +615,10 @@ fn bench(a: &BenchArgs) -> Result<(), Failure> {
     );
     println!(
         "ns_per_sample={ns_per_sample:.3} realtime_factor={realtime_factor:.3} points={} \
-         interactions={} compile_ms={compile_ms:.3} mean_ns={mean:.3}",
+         interactions={} compile_ms={compile_ms:.3} mean_ns={mean:.3} native_bytes={}",
         engine.info().num_points,
-        engine.info().num_interactions
+        engine.info().num_interactions,
+        engine.native_code_bytes().unwrap_or(0)
     );
     Ok(())
 }

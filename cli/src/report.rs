@@ -162,6 +162,13 @@ pub fn summary(path: &Path, spec: &ModelSpec, engine: &Engine, report: &Stabilit
             format!(", {}", buffers.join(", "))
         }
     );
+    let _ = match engine.native_code_bytes() {
+        Some(bytes) => writeln!(
+            s,
+            "sample loop   native code, {bytes} bytes (a small model, compiled when it loads)"
+        ),
+        None => writeln!(s, "sample loop   interpreter"),
+    };
     let violations = report.violations().count();
     let verdict = if violations == 0 {
         "stable: every mass satisfies 4M > K_eq + 2·Z_eq".to_string()

@@ -276,6 +276,39 @@ fn render_feeds_wav_inputs() {
     }
 }
 
+/// A small model runs on native code, which `--no-jit` turns off; `check` says which.
+#[test]
+fn a_small_model_runs_on_native_code() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = write(
+        dir.path(),
+        "osc.mdl",
+        "@g ground 0.\n@m mass 1. 0. 0.\n@l springDamper @g @m 0.01 0.0001\n\
+         @in1 frcInput @m\n@out1 posOutput @m\n",
+    );
+    let path = model.to_str().unwrap();
+    let native_bytes = |extra: &[&str]| {
+        let mut args = vec!["bench", path, "--seconds", "0.05"];
+        args.extend_from_slice(extra);
+        let out = ressort(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        let stdout = text(&out.stdout);
+        let last = stdout.lines().last().unwrap().to_string();
+        let bytes = last.rsplit_once("native_bytes=").unwrap().1.to_string();
+        bytes.parse::<usize>().unwrap()
+    };
+    assert!(native_bytes(&[]) > 0);
+    assert_eq!(native_bytes(&["--no-jit"]), 0);
+    let out = ressort(&["check", path]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("sample loop   native code, "), "{stdout}");
+    let out = ressort(&[
+        "check",
+        &write(dir.path(), "s.mdl", STRING_1000).to_string_lossy(),
+    ]);
+    assert!(text(&out.stdout).contains("sample loop   interpreter"));
+}
+
 #[test]
 fn bench_ends_with_the_machine_readable_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -297,10 +330,11 @@ fn bench_ends_with_the_machine_readable_line() {
             "points",
             "interactions",
             "compile_ms",
-            "mean_ns"
+            "mean_ns",
+            "native_bytes"
         ]
     );
-    for (k, v) in &fields {
+    for (k, v) in &fields[..6] {
         let x: f64 = v
             .parse()
             .unwrap_or_else(|_| panic!("{k}={v} is not a number"));
@@ -308,6 +342,8 @@ fn bench_ends_with_the_machine_readable_line() {
     }
     assert_eq!(fields[2].1, "1004");
     assert_eq!(fields[3].1, "1003");
+    // The 1000-mass string runs on the interpreter.
+    assert_eq!(fields[6].1, "0");
 }
 
 const STRING_10: &str = "\

@@ -239,7 +239,7 @@ fn a_mass_that_stops_being_plain_leaves_the_native_code() {
     }
 }
 
-/// Random networks of up to 24 points: any law between any two points, masses of every kind,
+/// Random networks of up to 21 points: any law between any two points, masses of every kind,
 /// avatars, inputs and outputs anywhere, arguments from parameters.
 #[test]
 fn random_networks_equal_the_interpreter() {

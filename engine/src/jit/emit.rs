@@ -15,7 +15,7 @@
 //! each that long, and every channel is addressed as base + 8·j.
 
 use super::laws::{self, Callees, Law};
-use super::{Frame, NativeCode, BAIL, MAX_LINKS, MAX_POINTS};
+use super::{Frame, NativeCode, BAIL, MAX_ELEMENTS};
 use crate::engine::{Engine, FLUSH_INTERVAL};
 use crate::kernels::links::Group;
 use cranelift_codegen::ir::condcodes::IntCC;
@@ -61,8 +61,7 @@ pub(super) fn fits(engine: &Engine) -> bool {
         && engine.proxies.len() == 0
         && engine.audio_params.is_empty()
         && engine.audio_bindings.is_empty()
-        && n <= MAX_POINTS
-        && links <= MAX_LINKS
+        && n + links <= MAX_ELEMENTS
         && n == engine.singles.len() + engine.avatars.len()
         && engine
             .avatars
@@ -398,7 +397,7 @@ impl<'a, 'b> Emitter<'a, 'b> {
             .collect()
     }
 
-    fn store_state(&mut self, x: Value, xp: Value, f: Value) {
+    pub(super) fn store_state(&mut self, x: Value, xp: Value, f: Value) {
         for p in 0..self.state.x.len() {
             for (var, base) in [
                 (self.state.x[p], x),

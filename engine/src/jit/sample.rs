@@ -11,8 +11,8 @@
 //!   finite.
 //!
 //! States the code does not handle at all (a non-finite input, a non-finite force on a
-//! ground) leave the sample for its bail-out block, which stores the state as before it; the
-//! driver runs that sample on the interpreter.
+//! ground) are tested before the sample changes anything; they leave it for its bail-out
+//! block, which stores the state, and the driver runs that sample on the interpreter.
 
 use super::emit::{Emitter, Setup, FLAGS};
 use super::laws;
@@ -32,24 +32,15 @@ impl Emitter<'_, '_> {
         arrays: (Value, Value, Value),
     ) {
         let e = self.e;
-        let n = e.points.x.len();
-        // The state before the sample, which a bail-out leaves stored.
-        let before: Vec<[Value; 3]> = (0..n)
-            .map(|p| {
-                [
-                    self.b.use_var(self.state.x[p]),
-                    self.b.use_var(self.state.xp[p]),
-                    self.b.use_var(self.state.f[p]),
-                ]
-            })
-            .collect();
         let bail = self.b.create_block();
         self.b.set_cold_block(bail);
         self.bail = Some(bail);
         let offset = self.b.ins().ishl_imm(j, 3);
 
-        // Each input channel read once; a non-finite sample counts as 0 in the interpreter,
-        // which runs such a sample.
+        // The states the code does not handle are all seen here, before the sample changes
+        // anything, so the bail-out stores the state as it stands. Each input channel is
+        // read once; the interpreter, which runs a sample with a non-finite input, reads it
+        // as 0. A ground's update needs its force to be finite (see `Emitter::ground`).
         let mut read = Vec::with_capacity(setup.inputs.len());
         for &(channel, base) in &setup.inputs {
             let at = self.b.ins().iadd(base, offset);
@@ -57,6 +48,11 @@ impl Emitter<'_, '_> {
             let finite = self.finite(v);
             self.bail_unless(finite);
             read.push((channel, v));
+        }
+        for i in (0..e.singles.len()).filter(|&i| e.singles.fixed[i]) {
+            let f = self.b.use_var(self.state.f[i]);
+            let finite = self.finite(f);
+            self.bail_unless(finite);
         }
         let zero = self.constant(0.0);
         let input = |ch: u32| read.iter().find(|r| r.0 == ch).map_or(zero, |r| r.1);
@@ -93,11 +89,7 @@ impl Emitter<'_, '_> {
         let current = self.b.current_block().expect("inside the sample");
         self.b.switch_to_block(bail);
         let (x, xp, f) = arrays;
-        for (p, values) in before.iter().enumerate() {
-            for (value, base) in values.iter().zip([x, xp, f]) {
-                self.b.ins().store(FLAGS, *value, base, (8 * p) as i32);
-            }
-        }
+        self.store_state(x, xp, f);
         let bailed = self.b.ins().bor_imm(k, BAIL);
         self.b.ins().return_(&[bailed]);
         self.b.switch_to_block(current);
@@ -113,7 +105,7 @@ impl Emitter<'_, '_> {
             let xp = self.b.use_var(self.state.xp[i]);
             let f = self.b.use_var(self.state.f[i]);
             let next = if e.singles.fixed[i] {
-                self.ground(x, f)
+                self.ground(x)
             } else if setup.masses.plain[i] {
                 // 2·X, as X + X (the same value, no constant to load).
                 let two_x = self.b.ins().fadd(x, x);
@@ -324,11 +316,9 @@ impl Emitter<'_, '_> {
     /// A ground's update, the general one with its constant coefficients (a, b, 1/M, g) =
     /// (1, 0, 0, 0): X[n+1] = (1·X + 0·X̃) + (F − 0)·0. That is X itself when X is not −0 and
     /// X, X̃ and F are finite (the products are zeros, and X + ±0 = X). The function checks X
-    /// and X̃ on entry, and they stay as they are while it runs; F is checked here, and the
-    /// sample bails out when it is not finite.
-    fn ground(&mut self, x: Value, f: Value) -> Value {
-        let finite = self.finite(f);
-        self.bail_unless(finite);
+    /// and X̃ on entry, and they stay as they are while it runs; the sample checked F before
+    /// it began.
+    fn ground(&mut self, x: Value) -> Value {
         x
     }
 }
