@@ -205,6 +205,13 @@ impl Engine {
             .map(|code| code.size())
     }
 
+    /// Whether this model is one the native code compiles (its kinds and size; see
+    /// `engine/src/jit.rs`), whether or not it got the code. A model that fits and runs on
+    /// the interpreter with [`crate::CompileOptions::jit`] set means Cranelift failed on it.
+    pub fn fits_native_code(&self) -> bool {
+        emit::fits(self)
+    }
+
     /// Samples `start..end` of a block on the native code (`self.native`, which `fits`):
     /// what [`Engine::run`] does on the interpreter, with the same samples. Returns how many
     /// samples ran (fewer when the guard trips).

@@ -84,15 +84,18 @@ impl Emitter<'_, '_> {
         }
         self.outputs(k, offset, setup, bad);
 
-        // The bail-out: the state as before the sample.
+        // The sample goes on in a block of its own (a model without outputs has not started
+        // one), so the bail-out can be filled now: the state as before the sample.
+        let next = self.b.create_block();
+        self.b.ins().jump(next, &[]);
+        self.b.seal_block(next);
         self.b.seal_block(bail);
-        let current = self.b.current_block().expect("inside the sample");
         self.b.switch_to_block(bail);
         let (x, xp, f) = arrays;
         self.store_state(x, xp, f);
         let bailed = self.b.ins().bor_imm(k, BAIL);
         self.b.ins().return_(&[bailed]);
-        self.b.switch_to_block(current);
+        self.b.switch_to_block(next);
     }
 
     /// Stage 2 a: single masses (`kernels::masses`): plain X[n+1] = (2·X − X̃) + F·(1/M),
