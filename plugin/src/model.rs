@@ -281,13 +281,27 @@ impl ModelStore {
     /// diagnostics.
     pub fn submit(&self, state: ModelState) -> Result<(), Rejected> {
         let _preparing = lock(&self.preparing);
+        self.submit_prepared(state)
+    }
+
+    /// [`ModelStore::submit`], with `preparing` held by the caller.
+    fn submit_prepared(&self, state: ModelState) -> Result<(), Rejected> {
         self.collect_garbage();
         let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
+        // This model gets the Voices setting as it stands now, so a setting that changed
+        // before is applied by this submission (a state load sets Voices, then the model):
+        // the watch must not prepare the model again and cut the notes it plays. A setting
+        // that changes from here on marks it stale again.
+        let was_stale = rate > 0.0 && self.voices_stale.swap(false, Ordering::AcqRel);
         let result = if rate > 0.0 {
             prepare(&state.name, &state.script, rate, self.voices()).map(Some)
         } else {
             parse_script(&state.script).map(|_| None)
         };
+        if result.is_err() && was_stale {
+            // The running model keeps its old Voices setting.
+            self.voices_stale.store(true, Ordering::Release);
+        }
         match result {
             Ok(prepared) => {
                 let mut status = lock(&self.status);
@@ -350,11 +364,15 @@ impl ModelStore {
     /// Re-prepares the running script with the current Voices setting (any thread but the
     /// audio thread; a no-op while inactive or when nothing changed).
     pub fn apply_voices(&self) {
-        if self.voices_stale.swap(false, Ordering::AcqRel) {
-            let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
-            if rate > 0.0 {
-                let _ = self.submit(self.running());
-            }
+        if !self.voices_stale() {
+            return;
+        }
+        // The running script is read under `preparing`: read before it, a state load that
+        // submits in between would be undone by the script it replaced.
+        let _preparing = lock(&self.preparing);
+        let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
+        if self.voices_stale() && rate > 0.0 {
+            let _ = self.submit_prepared(self.running());
         }
     }
 
@@ -371,6 +389,7 @@ impl ModelStore {
     /// (so B starts where A is). A slot whose script no longer loads keeps the running model
     /// and reports why.
     pub fn switch_compare(&self) -> Result<(), Rejected> {
+        let _preparing = lock(&self.preparing);
         let running = self.running();
         let mut c = lock(&self.compare);
         let from = c.active;
@@ -379,7 +398,7 @@ impl ModelStore {
         let target = c.slots[to].clone().unwrap_or(running);
         c.active = to;
         drop(c);
-        let result = self.submit(target);
+        let result = self.submit_prepared(target);
         if result.is_err() {
             lock(&self.compare).active = from;
         }

@@ -59,6 +59,7 @@ impl Drop for VoicesWatch {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::ModelState;
     use std::time::Instant;
 
     #[test]
@@ -86,6 +87,68 @@ mod tests {
         // Unchanged settings are not re-prepared, and dropping the watch stops its thread.
         std::thread::sleep(INTERVAL * 3);
         assert!(store.receive().is_none());
+        drop(watch);
+    }
+
+    fn script(name: &str, k: f64) -> ModelState {
+        ModelState {
+            name: name.into(),
+            script: format!("@o osc 1. {k} 0.0002 0. 0.\n@in1 frcInput @o\n@out1 posOutput @o\n"),
+        }
+    }
+
+    /// A state load sets Voices, then the model: that model is prepared with the new setting,
+    /// so the watch has nothing left to do and does not prepare it again (which would cut
+    /// the notes it plays).
+    #[test]
+    fn a_model_submitted_after_a_voices_change_takes_it() {
+        let store = Arc::new(ModelStore::default());
+        store.set_voices(1);
+        store
+            .activate(48_000.0)
+            .expect("the default model compiles");
+        store.set_voices(8);
+        assert!(store.voices_stale());
+        store.submit(script("loaded", 0.02)).expect("compiles");
+        assert!(!store.voices_stale());
+        let generation = store.generation();
+        store.apply_voices();
+        assert_eq!(store.generation(), generation, "prepared again");
+        let model = store.receive().expect("the loaded model");
+        assert_eq!((model.name.as_str(), model.voices()), ("loaded", 8));
+        // A script that does not compile leaves the setting to be applied to the running one.
+        store.set_voices(3);
+        assert!(store.submit(script("broken", f64::NAN)).is_err());
+        assert!(store.voices_stale());
+    }
+
+    /// The watch and state loads on two threads: whatever the interleaving, the last
+    /// model sent is the last script submitted, never the one it replaced.
+    #[test]
+    fn the_watch_never_brings_back_a_replaced_script() {
+        let store = Arc::new(ModelStore::default());
+        store
+            .activate(48_000.0)
+            .expect("the default model compiles");
+        let watch = VoicesWatch::start(store.clone()).expect("a thread");
+        for round in 0..40 {
+            store.set_voices(1 + round % 5);
+            let name = format!("model {round}");
+            store
+                .submit(script(&name, 0.01 + 0.0001 * round as f64))
+                .expect("compiles");
+            std::thread::sleep(Duration::from_millis(round as u64 % 7));
+            // The watch may still re-prepare it; it must be the same script.
+            std::thread::sleep(INTERVAL * 2);
+            let mut last = None;
+            while let Some(m) = store.receive() {
+                last = Some(m);
+            }
+            if let Some(m) = last {
+                assert_eq!(m.name, name, "round {round}");
+            }
+            assert_eq!(store.running().name, name, "round {round}");
+        }
         drop(watch);
     }
 }
