@@ -766,8 +766,9 @@ impl Engine {
         }
         // Stage 2 a: single mass-type elements; 2 b: macros and their internal links.
         self.singles.step(&mut self.points);
+        let avx2 = crate::kernels::is_avx2(self.arch);
         self.macros
-            .step(&mut self.points, &self.args, &self.proxies);
+            .step(&mut self.points, &self.args, &self.proxies, avx2);
         // Stage 3: connection-point positions.
         self.proxies.update_positions(&mut self.points);
         // Stage 4: interactions, then force inputs.

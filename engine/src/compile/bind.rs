@@ -229,8 +229,14 @@ impl<'a> Cx<'a> {
             }
         }
         macros.scratch_v = vec![0.0; largest_macro];
-        // The row sweep of a large mesh takes five rows.
-        let widest = macros.meshes.iter().map(|m| 5 * m.width).max().unwrap_or(0);
+        // The row sweep of a large mesh takes some rows of its own.
+        let rows = crate::kernels::mesh::SCRATCH_ROWS;
+        let widest = macros
+            .meshes
+            .iter()
+            .map(|m| rows * m.width)
+            .max()
+            .unwrap_or(0);
         macros.scratch_s = vec![0.0; largest_macro.max(widest)];
         macros
     }

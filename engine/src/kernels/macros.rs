@@ -71,7 +71,9 @@ impl Macros {
     }
 
     #[inline(always)]
-    pub(crate) fn step(&mut self, p: &mut Points, args: &[f64], proxies: &Proxies) {
+    /// `avx2`: the sample loop runs with AVX2 (pulp's V3), so the large plates may use the
+    /// row sweep's AVX2 loop ([`crate::kernels::mesh`]).
+    pub(crate) fn step(&mut self, p: &mut Points, args: &[f64], proxies: &Proxies, avx2: bool) {
         let (v, s) = (&mut self.scratch_v, &mut self.scratch_s);
         for mac in &self.lines {
             let range = mac.base..mac.base + mac.len;
@@ -98,7 +100,7 @@ impl Macros {
             let f = &mut p.f[range];
             if n >= ROW_SWEEP_NODES {
                 let ext = take_spread_forces(mac, proxies, f, &mut self.scratch_ext);
-                mesh_step_rows(mac, x, xp, s, ext, args);
+                mesh_step_rows(mac, x, xp, s, ext, args, avx2);
             } else {
                 mesh_step_passes(mac, x, xp, f, v, s, args);
             }

@@ -13,6 +13,10 @@ use crate::laws;
 /// six passes stream more than the caches hold.
 pub(crate) const ROW_SWEEP_NODES: usize = 4096;
 
+/// Rows of scratch [`mesh_step_rows`] needs: link forces, forces from the row above, a
+/// row's forces, two velocity rows, two rows of connection-point forces.
+pub(crate) const SCRATCH_ROWS: usize = 7;
+
 /// Pass by pass: every node moves with the node law; pinned nodes are then reset to
 /// x = x̃ = x_edge (node 0's position before the update); then the links (i,j)–(i,j+1) for all
 /// rows, then (i,j)–(i+1,j).
@@ -101,6 +105,7 @@ pub(crate) fn mesh_step_rows(
     scratch: &mut [f64],
     ext: &[(u32, f64)],
     args: &[f64],
+    avx2: bool,
 ) {
     let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
     let (k, z) = mac.last_kz;
@@ -112,7 +117,13 @@ pub(crate) fn mesh_step_rows(
     // Velocities x − x̃ at the start of the sample: row r's, and row r + 1's, which row r
     // computes for its links below and hands on.
     let (v_even, rest) = rest.split_at_mut(w);
-    let v_odd = &mut rest[..w];
+    let (v_odd, rest) = rest.split_at_mut(w);
+    // The connection points' forces on the rows being moved, −0 where there is none
+    // (F + −0 is F): the inner loops add them last, as `any_row` does.
+    let (e0, rest) = rest.split_at_mut(w);
+    let e1 = &mut rest[..w];
+    e0.fill(-0.0);
+    e1.fill(-0.0);
     let law = NodeLaw { a, b, inv_m, k, z };
     let x_edge = x[0];
     let (mut pin, mut e) = (0, 0);
@@ -121,29 +132,43 @@ pub(crate) fn mesh_step_rows(
     let mut row = 0;
     while row < len {
         let r = row * w;
-        let first_ext = e;
-        while e < ext.len() && (ext[e].0 as usize) < r + w {
-            e += 1;
-        }
-        let ext_row = &ext[first_ext..e];
         let (v_row, v_next) = if v_in_even {
             (&*v_even, &mut *v_odd)
         } else {
             (&*v_odd, &mut *v_even)
         };
         v_in_even = !v_in_even;
-        let pair = row > 0
-            && row + 2 < len
-            && ext_row.is_empty()
-            && ext.get(e).is_none_or(|&(n, _)| n as usize >= r + 2 * w);
-        if pair {
-            inner_pair(&law, w, r, x, xp, up, v_row, v_next);
+        let first_ext = e;
+        if row > 0 && row + 2 < len {
+            // Two rows, with their connection points' forces if any.
+            while e < ext.len() && (ext[e].0 as usize) < r + 2 * w {
+                e += 1;
+            }
+            let pair_ext = &ext[first_ext..e];
+            if pair_ext.is_empty() {
+                inner_pair::<false>(&law, w, r, x, xp, up, v_row, v_next, e0, e1, avx2);
+            } else {
+                place(pair_ext, r, e0, e1, f64::from_bits);
+                inner_pair::<true>(&law, w, r, x, xp, up, v_row, v_next, e0, e1, avx2);
+                place(pair_ext, r, e0, e1, |_| -0.0);
+            }
             row += 2;
-        } else if row > 0 && row + 1 < len && ext_row.is_empty() {
-            inner_row(&law, w, r, x, xp, up, v_row, v_next);
-            row += 1;
         } else {
-            any_row(&law, w, r, len, x, xp, s, up, fbuf, ext_row, v_next);
+            while e < ext.len() && (ext[e].0 as usize) < r + w {
+                e += 1;
+            }
+            let ext_row = &ext[first_ext..e];
+            if row > 0 && row + 1 < len {
+                if ext_row.is_empty() {
+                    inner_row::<false>(&law, w, r, x, xp, up, v_row, v_next, e0);
+                } else {
+                    place(ext_row, r, e0, e1, f64::from_bits);
+                    inner_row::<true>(&law, w, r, x, xp, up, v_row, v_next, e0);
+                    place(ext_row, r, e0, e1, |_| -0.0);
+                }
+            } else {
+                any_row(&law, w, r, len, x, xp, s, up, fbuf, ext_row, v_next);
+            }
             row += 1;
         }
         let done = row * w;
@@ -155,13 +180,29 @@ pub(crate) fn mesh_step_rows(
     }
 }
 
+/// Writes `value(force bits)` of each connection-point force on rows `r` and `r + 1` into
+/// their rows `e0` and `e1`.
+#[inline(always)]
+fn place(ext: &[(u32, f64)], r: usize, e0: &mut [f64], e1: &mut [f64], value: fn(u64) -> f64) {
+    let w = e0.len();
+    for &(node, fe) in ext {
+        let j = node as usize - r;
+        let v = value(fe.to_bits());
+        if j < w {
+            e0[j] = v;
+        } else {
+            e1[j - w] = v;
+        }
+    }
+}
+
 /// The coefficients of one sample of the row sweep.
-struct NodeLaw {
-    a: f64,
-    b: f64,
-    inv_m: f64,
-    k: f64,
-    z: f64,
+pub(super) struct NodeLaw {
+    pub a: f64,
+    pub b: f64,
+    pub inv_m: f64,
+    pub k: f64,
+    pub z: f64,
 }
 
 /// The links along row `r..r + w`, from the state at the start of the sample: s_j between
@@ -183,7 +224,7 @@ fn row_links(law: &NodeLaw, x: &[f64], xp: &[f64], s: &mut [f64]) {
 /// velocities come from the row above; the row below's go to the next row.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn inner_row(
+fn inner_row<const EXT: bool>(
     law: &NodeLaw,
     w: usize,
     r: usize,
@@ -192,10 +233,11 @@ fn inner_row(
     up: &mut [f64],
     v_row: &[f64],
     v_below: &mut [f64],
+    ext: &[f64],
 ) {
     let (x_to, x_below) = x.split_at_mut(r + w);
     let (xp_to, xp_below) = xp.split_at_mut(r + w);
-    inner_nodes(
+    inner_nodes::<EXT>(
         law,
         &mut x_to[r..],
         &mut xp_to[r..],
@@ -204,6 +246,7 @@ fn inner_row(
         &xp_below[..w],
         &mut v_below[..w],
         &mut up[..w],
+        &ext[..w],
     );
 }
 
@@ -211,9 +254,11 @@ fn inner_row(
 /// they do not overlap, and vectorises it (they lose that inside a struct). The first and
 /// last nodes repeat the loop's body on purpose: with the body in a helper function shared
 /// by all three, the loop no longer vectorised (the plate took 66 µs instead of 23).
+/// With `EXT`, each node's force ends with the connection points' force on it, `ext` (−0
+/// where there is none).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn inner_nodes(
+fn inner_nodes<const EXT: bool>(
     law: &NodeLaw,
     xr: &mut [f64],
     xpr: &mut [f64],
@@ -222,19 +267,24 @@ fn inner_nodes(
     xpb: &[f64],
     vb_out: &mut [f64],
     up: &mut [f64],
+    ext: &[f64],
 ) {
     let w = xr.len();
     let (xpr, vr, xb, xpb) = (&mut xpr[..w], &vr[..w], &xb[..w], &xpb[..w]);
-    let (vb_out, up) = (&mut vb_out[..w], &mut up[..w]);
+    let (vb_out, up, ext) = (&mut vb_out[..w], &mut up[..w], &ext[..w]);
+    let with_ext = |f: f64, j: usize| if EXT { f + ext[j] } else { f };
     let NodeLaw { a, b, inv_m, k, z } = *law;
     // Node 0: −s_0, then the links above and below.
     let mut s_left = laws::spring_damper(xr[0] - xr[1], vr[0] - vr[1], k, z);
+    // The last row link, for node W − 1, before the loop moves node W − 2 (see
+    // `pair_nodes`).
+    let s_last = laws::spring_damper(xr[w - 2] - xr[w - 1], vr[w - 2] - vr[w - 1], k, z);
     {
         let (xj, vj) = (xr[0], vr[0]);
         let vbj = xb[0] - xpb[0];
         vb_out[0] = vbj;
         let sv = laws::spring_damper(xj - xb[0], vj - vbj, k, z);
-        let fj = (-s_left + up[0]) - sv;
+        let fj = with_ext((-s_left + up[0]) - sv, 0);
         up[0] = sv;
         xr[0] = a * xj + b * xpr[0] + fj * inv_m;
         xpr[0] = xj;
@@ -245,7 +295,7 @@ fn inner_nodes(
         let vbj = xb[j] - xpb[j];
         vb_out[j] = vbj;
         let sv = laws::spring_damper(xj - xb[j], vj - vbj, k, z);
-        let fj = ((s_left - s_right) + up[j]) - sv;
+        let fj = with_ext(((s_left - s_right) + up[j]) - sv, j);
         s_left = s_right;
         up[j] = sv;
         xr[j] = a * xj + b * xpr[j] + fj * inv_m;
@@ -257,7 +307,7 @@ fn inner_nodes(
     let vbj = xb[j] - xpb[j];
     vb_out[j] = vbj;
     let sv = laws::spring_damper(xj - xb[j], vj - vbj, k, z);
-    let fj = (s_left + up[j]) - sv;
+    let fj = with_ext((s_last + up[j]) - sv, j);
     up[j] = sv;
     xr[j] = a * xj + b * xpr[j] + fj * inv_m;
     xpr[j] = xj;
@@ -269,7 +319,7 @@ fn inner_nodes(
 /// r + 2's go to the next row. The same sums in the same order as [`inner_row`] twice.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn inner_pair(
+fn inner_pair<const EXT: bool>(
     law: &NodeLaw,
     w: usize,
     r: usize,
@@ -278,12 +328,15 @@ fn inner_pair(
     up: &mut [f64],
     v_row: &[f64],
     v_next: &mut [f64],
+    e0: &[f64],
+    e1: &[f64],
+    avx2: bool,
 ) {
     let (x0, rest) = x[r..].split_at_mut(w);
     let (x1, rest) = rest.split_at_mut(w);
     let (xp0, xp_rest) = xp[r..].split_at_mut(w);
     let (xp1, xp_rest) = xp_rest.split_at_mut(w);
-    pair_nodes(
+    pair_nodes::<EXT>(
         law,
         x0,
         xp0,
@@ -294,14 +347,18 @@ fn inner_pair(
         &xp_rest[..w],
         &mut v_next[..w],
         &mut up[..w],
+        &e0[..w],
+        &e1[..w],
+        avx2,
     );
 }
 
 /// [`inner_pair`]'s loop, each row its own argument for the vectoriser (see
-/// [`inner_nodes`]; in an array they lose their no-alias facts too).
+/// [`inner_nodes`]; in an array they lose their no-alias facts too). With `EXT`, the rows'
+/// connection-point forces `e0` and `e1` end each node's force.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn pair_nodes(
+fn pair_nodes<const EXT: bool>(
     law: &NodeLaw,
     x0: &mut [f64],
     xp0: &mut [f64],
@@ -312,14 +369,28 @@ fn pair_nodes(
     xp2: &[f64],
     v2_out: &mut [f64],
     up: &mut [f64],
+    e0: &[f64],
+    e1: &[f64],
+    avx2: bool,
 ) {
     let w = x0.len();
     let (xp0, x1, xp1, v0) = (&mut xp0[..w], &mut x1[..w], &mut xp1[..w], &v0[..w]);
     let (x2, xp2, v2_out, up) = (&x2[..w], &xp2[..w], &mut v2_out[..w], &mut up[..w]);
+    let (e0, e1) = (&e0[..w], &e1[..w]);
+    let with_ext = |f: f64, e: &[f64], j: usize| if EXT { f + e[j] } else { f };
     let NodeLaw { a, b, inv_m, k, z } = *law;
     let link = |dx: f64, dv: f64| laws::spring_damper(dx, dv, k, z);
     let mut s0_left = link(x0[0] - x0[1], v0[0] - v0[1]);
     let mut s1_left = link(x1[0] - x1[1], (x1[0] - xp1[0]) - (x1[1] - xp1[1]));
+    // The last row links, for node W − 1, from the state before the loop moves node W − 2:
+    // the loop's own s_left then ends unused, and the compiler vectorises every node of it
+    // instead of leaving a scalar tail.
+    let j = w - 2;
+    let s0_last = link(x0[j] - x0[j + 1], v0[j] - v0[j + 1]);
+    let s1_last = link(
+        x1[j] - x1[j + 1],
+        (x1[j] - xp1[j]) - (x1[j + 1] - xp1[j + 1]),
+    );
     // Node 0 of both rows: −s_0, then the links above and below.
     {
         let (x0j, v0j, x1j) = (x0[0], v0[0], x1[0]);
@@ -328,15 +399,28 @@ fn pair_nodes(
         v2_out[0] = v2j;
         let s01 = link(x0j - x1j, v0j - v1j);
         let s12 = link(x1j - x2[0], v1j - v2j);
-        let f0 = (-s0_left + up[0]) - s01;
-        let f1 = (-s1_left + s01) - s12;
+        let f0 = with_ext((-s0_left + up[0]) - s01, e0, 0);
+        let f1 = with_ext((-s1_left + s01) - s12, e1, 0);
         up[0] = s12;
         x0[0] = a * x0j + b * xp0[0] + f0 * inv_m;
         xp0[0] = x0j;
         x1[0] = a * x1j + b * xp1[0] + f1 * inv_m;
         xp1[0] = x1j;
     }
-    for j in 1..w - 1 {
+    let mut first = 1;
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: `avx2` is set only when the sample loop runs with AVX2 (pulp's V3); the rows
+        // are W long.
+        (first, s0_left, s1_left) = unsafe {
+            super::mesh_avx2::pair_columns::<EXT>(
+                law, x0, xp0, x1, xp1, v0, x2, xp2, v2_out, up, e0, e1, s0_left, s1_left,
+            )
+        };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = avx2;
+    for j in first..w - 1 {
         let (x0j, v0j, x1j) = (x0[j], v0[j], x1[j]);
         let s0_right = link(x0j - x0[j + 1], v0j - v0[j + 1]);
         let v1j = x1j - xp1[j];
@@ -345,8 +429,8 @@ fn pair_nodes(
         v2_out[j] = v2j;
         let s01 = link(x0j - x1j, v0j - v1j);
         let s12 = link(x1j - x2[j], v1j - v2j);
-        let f0 = ((s0_left - s0_right) + up[j]) - s01;
-        let f1 = ((s1_left - s1_right) + s01) - s12;
+        let f0 = with_ext(((s0_left - s0_right) + up[j]) - s01, e0, j);
+        let f1 = with_ext(((s1_left - s1_right) + s01) - s12, e1, j);
         s0_left = s0_right;
         s1_left = s1_right;
         up[j] = s12;
@@ -363,8 +447,8 @@ fn pair_nodes(
     v2_out[j] = v2j;
     let s01 = link(x0j - x1j, v0j - v1j);
     let s12 = link(x1j - x2[j], v1j - v2j);
-    let f0 = (s0_left + up[j]) - s01;
-    let f1 = (s1_left + s01) - s12;
+    let f0 = with_ext((s0_last + up[j]) - s01, e0, j);
+    let f1 = with_ext((s1_last + s01) - s12, e1, j);
     up[j] = s12;
     x0[j] = a * x0j + b * xp0[j] + f0 * inv_m;
     xp0[j] = x0j;
@@ -434,7 +518,17 @@ mod tests {
     /// changing.
     #[test]
     fn rows_and_passes_are_bit_identical() {
-        for (len, w) in [(7, 5), (2, 2), (5, 3), (3, 9), (9, 2), (2, 7)] {
+        for (len, w) in [
+            (7, 5),
+            (2, 2),
+            (5, 3),
+            (3, 9),
+            (9, 2),
+            (2, 7),
+            (8, 11),
+            (6, 14),
+            (10, 6),
+        ] {
             mesh_schedules_agree(len, w);
         }
     }
@@ -477,8 +571,13 @@ mod tests {
             let (mut x1, mut xp1, mut f1) = (start(0.7), start(1.3), vec![0.0; n]);
             let (mut x2, mut xp2) = (x1.clone(), xp1.clone());
             let (mut v1, mut s1) = (vec![0.0; n], vec![0.0; n]);
-            let mut scratch = vec![0.0; 5 * w];
+            let mut scratch = vec![0.0; SCRATCH_ROWS * w];
             let mut diverged = false;
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            // The AVX2 loop, where the CPU has it, from the same start.
+            let mut with_avx2 = crate::kernels::avx2()
+                .is_some()
+                .then(|| (mac.clone(), x2.clone(), xp2.clone(), scratch.clone()));
             for step in 0..50 {
                 let args = [1.3, 0.21 + 0.01 * (step % 3) as f64, 0.0, 0.013, 0.002];
                 // Forces on a node in the first row, one inside, one in the last row.
@@ -492,8 +591,21 @@ mod tests {
                     f1[i as usize] += fe;
                 }
                 mesh_step_passes(&mac, &mut x1, &mut xp1, &mut f1, &mut v1, &mut s1, &args);
-                mesh_step_rows(&mut mac, &mut x2, &mut xp2, &mut scratch, &ext, &args);
-                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                mesh_step_rows(
+                    &mut mac,
+                    &mut x2,
+                    &mut xp2,
+                    &mut scratch,
+                    &ext,
+                    &args,
+                    false,
+                );
+                if let Some(avx2) = &mut with_avx2 {
+                    let (mac, x, xp, scratch) = avx2;
+                    mesh_step_rows(mac, x, xp, scratch, &ext, &args, true);
+                    assert_eq!(bits(x), bits(&x2), "AVX2, {len}×{w}, sample {step}");
+                    assert_eq!(bits(xp), bits(&xp2), "AVX2, {len}×{w}, sample {step}");
+                }
                 assert_eq!(bits(&x1), bits(&x2), "{len}×{w}, sample {step}");
                 assert_eq!(bits(&xp1), bits(&xp2), "{len}×{w}, sample {step}");
                 diverged |= x1 != start(0.7);

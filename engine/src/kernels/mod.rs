@@ -4,6 +4,8 @@ pub(crate) mod links;
 pub(crate) mod macros;
 pub(crate) mod masses;
 pub(crate) mod mesh;
+#[cfg(target_arch = "x86_64")]
+mod mesh_avx2;
 pub(crate) mod proxies;
 
 /// Mesh macros with rows shorter than this run the sample loop with AVX2 rather than AVX-512.
@@ -21,6 +23,20 @@ pub(crate) fn avx2() -> Option<pulp::Arch> {
     #[cfg(not(target_arch = "x86_64"))]
     {
         None
+    }
+}
+
+/// Whether `arch` is AVX2 (pulp's V3), which the large plates' row sweep has a loop of its
+/// own for.
+pub(crate) fn is_avx2(arch: pulp::Arch) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        matches!(arch, pulp::Arch::V3(_))
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = arch;
+        false
     }
 }
 
