@@ -837,7 +837,7 @@ impl Engine {
     }
 
     /// Sets every position, delayed position and pending force below [`FLUSH_BELOW`] to exactly
-    /// 0 (a select, not a branch, so that it vectorises). The forces count: stage 4 leaves them
+    /// 0 (a mask, not a branch, so that it vectorises). The forces count: stage 4 leaves them
     /// for the next sample's mass update, and a tail flushed without them comes back from them.
     #[inline(always)]
     pub(crate) fn flush_tiny(&mut self) {
@@ -845,7 +845,13 @@ impl Engine {
         // One loop per array: a chain of the three does not vectorise.
         for a in [&mut p.x, &mut p.xp, &mut p.f] {
             for v in a.iter_mut() {
-                *v = if v.abs() < FLUSH_BELOW { 0.0 } else { *v };
+                // Every value is written back: v·1 + 0 is v for any v that is not tiny
+                // (NaN stays for the guard), v·0 + 0 is +0 for a tiny one (−0 included).
+                // Written as a select (or as a bit mask, which the compiler turns back into
+                // one), this compiled into AVX masked stores, which Zen CPUs run microcoded:
+                // the flush cost 3 % of the Chladni plate's time.
+                let keep = if v.abs() < FLUSH_BELOW { 0.0 } else { 1.0 };
+                *v = *v * keep + 0.0;
             }
         }
     }

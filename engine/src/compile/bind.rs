@@ -211,20 +211,13 @@ impl<'a> Cx<'a> {
                     slots,
                 }),
                 MacroKind::Mesh | MacroKind::CornerMesh | MacroKind::ClosedMesh => {
-                    macros.meshes.push(MeshMacro {
-                        base: base_us,
-                        length: mac.length as usize,
-                        width: mac.width as usize,
-                        // Ascending: the mesh kernel pins them row by row.
-                        pinned: {
-                            let mut p = fixed.clone();
-                            p.sort_unstable();
-                            p.dedup();
-                            p
-                        },
+                    macros.meshes.push(MeshMacro::new(
+                        base_us,
+                        mac.length as usize,
+                        mac.width as usize,
+                        fixed.clone(),
                         slots,
-                        last_kz: (0.0, 0.0),
-                    })
+                    ))
                 }
             }
         }

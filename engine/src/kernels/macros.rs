@@ -31,12 +31,42 @@ pub(crate) struct MeshMacro {
     pub base: usize,
     pub length: usize,
     pub width: usize,
-    /// Local indices of pinned nodes (corners or border).
+    /// Local indices of pinned nodes (corners or border), ascending.
     pub pinned: Vec<u32>,
+    /// Whether every row's first and last nodes are pinned (a closed mesh): the row sweep
+    /// then leaves them to the pinning instead of moving them first.
+    pub sides_pinned: bool,
     pub slots: MacroSlots,
     /// K and Z of the previous sample, (0, 0) before the first: the row sweep computes the
     /// previous sample's link forces with them ([`mesh_step_rows`]).
     pub last_kz: (f64, f64),
+}
+
+impl MeshMacro {
+    /// A mesh of `length` rows of `width` nodes from `base`, with the nodes `pinned` (local
+    /// indices, in any order).
+    pub(crate) fn new(
+        base: usize,
+        length: usize,
+        width: usize,
+        mut pinned: Vec<u32>,
+        slots: MacroSlots,
+    ) -> MeshMacro {
+        pinned.sort_unstable();
+        pinned.dedup();
+        let is_pinned = |i: usize| pinned.binary_search(&(i as u32)).is_ok();
+        let sides_pinned = width > 0
+            && (0..length).all(|r| is_pinned(r * width) && is_pinned(r * width + width - 1));
+        MeshMacro {
+            base,
+            length,
+            width,
+            pinned,
+            sides_pinned,
+            slots,
+            last_kz: (0.0, 0.0),
+        }
+    }
 }
 
 /// The per-step coefficients of the ground-friction node law of spec §2.7:
@@ -213,14 +243,7 @@ mod tests {
     /// their slots cleared; a connection point on another macro is left alone.
     #[test]
     fn spread_forces_are_taken_once_per_node() {
-        let mac = MeshMacro {
-            base: 10,
-            length: 3,
-            width: 4,
-            pinned: vec![],
-            slots: MacroSlots::default(),
-            last_kz: (0.0, 0.0),
-        };
+        let mac = MeshMacro::new(10, 3, 4, vec![], MacroSlots::default());
         let proxies = Proxies {
             nodes: vec![[16, 17, 20, 21], [0, 1, 0, 0], [15, 16, 19, 20]],
             geometry: vec![(10, 3, 4), (0, 5, 0), (10, 3, 4)],

@@ -125,6 +125,7 @@ pub(crate) fn mesh_step_rows(
     e0.fill(-0.0);
     e1.fill(-0.0);
     let law = NodeLaw { a, b, inv_m, k, z };
+    let sides = mac.sides_pinned;
     let x_edge = x[0];
     let (mut pin, mut e) = (0, 0);
     // Which ring holds the velocities of the next row to move.
@@ -146,10 +147,10 @@ pub(crate) fn mesh_step_rows(
             }
             let pair_ext = &ext[first_ext..e];
             if pair_ext.is_empty() {
-                inner_pair::<false>(&law, w, r, x, xp, up, v_row, v_next, e0, e1, avx2);
+                inner_pair::<false>(&law, w, r, x, xp, up, v_row, v_next, e0, e1, avx2, sides);
             } else {
                 place(pair_ext, r, e0, e1, f64::from_bits);
-                inner_pair::<true>(&law, w, r, x, xp, up, v_row, v_next, e0, e1, avx2);
+                inner_pair::<true>(&law, w, r, x, xp, up, v_row, v_next, e0, e1, avx2, sides);
                 place(pair_ext, r, e0, e1, |_| -0.0);
             }
             row += 2;
@@ -331,6 +332,7 @@ fn inner_pair<const EXT: bool>(
     e0: &[f64],
     e1: &[f64],
     avx2: bool,
+    sides_pinned: bool,
 ) {
     let (x0, rest) = x[r..].split_at_mut(w);
     let (x1, rest) = rest.split_at_mut(w);
@@ -350,6 +352,7 @@ fn inner_pair<const EXT: bool>(
         &e0[..w],
         &e1[..w],
         avx2,
+        sides_pinned,
     );
 }
 
@@ -372,6 +375,7 @@ fn pair_nodes<const EXT: bool>(
     e0: &[f64],
     e1: &[f64],
     avx2: bool,
+    sides_pinned: bool,
 ) {
     let w = x0.len();
     let (xp0, x1, xp1, v0) = (&mut xp0[..w], &mut x1[..w], &mut xp1[..w], &v0[..w]);
@@ -391,8 +395,13 @@ fn pair_nodes<const EXT: bool>(
         x1[j] - x1[j + 1],
         (x1[j] - xp1[j]) - (x1[j + 1] - xp1[j + 1]),
     );
-    // Node 0 of both rows: −s_0, then the links above and below.
-    {
+    // Node 0 of both rows: −s_0, then the links above and below. Pinned sides are set by
+    // the pinning after the pair, whatever is computed here, and their link below only
+    // reaches the pinned node under them: only row r + 2's velocity, which the next pair's
+    // links read, is needed.
+    if sides_pinned {
+        v2_out[0] = x2[0] - xp2[0];
+    } else {
         let (x0j, v0j, x1j) = (x0[0], v0[0], x1[0]);
         let v1j = x1j - xp1[0];
         let v2j = x2[0] - xp2[0];
@@ -439,8 +448,12 @@ fn pair_nodes<const EXT: bool>(
         x1[j] = a * x1j + b * xp1[j] + f1 * inv_m;
         xp1[j] = x1j;
     }
-    // Node W − 1 of both rows: s_W−2, then the links above and below.
+    // Node W − 1 of both rows: s_W−2, then the links above and below; pinned as node 0.
     let j = w - 1;
+    if sides_pinned {
+        v2_out[j] = x2[j] - xp2[j];
+        return;
+    }
     let (x0j, v0j, x1j) = (x0[j], v0[j], x1[j]);
     let v1j = x1j - xp1[j];
     let v2j = x2[j] - xp2[j];
@@ -546,21 +559,16 @@ mod tests {
             c.dedup();
             c
         };
-        for pinned in [vec![], corners, closed] {
-            let mut mac = MeshMacro {
-                base: 0,
-                length: len,
-                width: w,
-                pinned,
-                slots: MacroSlots {
-                    m: 0,
-                    k: 1,
-                    k2: 2,
-                    z: 3,
-                    zo: 4,
-                },
-                last_kz: (0.0, 0.0),
+        for (sides, pinned) in [(false, vec![]), (len == 2, corners), (true, closed)] {
+            let slots = MacroSlots {
+                m: 0,
+                k: 1,
+                k2: 2,
+                z: 3,
+                zo: 4,
             };
+            let mut mac = MeshMacro::new(0, len, w, pinned, slots);
+            assert_eq!(mac.sides_pinned, sides);
             let start = |seed: f64| -> Vec<f64> {
                 (0..n)
                     .map(|i| ((i as f64 + 1.0) * seed).sin() * 0.1)
