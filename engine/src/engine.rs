@@ -40,12 +40,15 @@ pub(crate) struct Points {
     pub s: Vec<f64>,
 }
 
-/// The host buffers' shape for one block of [`Engine::process`].
-struct BlockIo<'a> {
-    frames: usize,
-    inputs: &'a [f64],
-    in_channels: usize,
-    out_channels: usize,
+/// The host buffers' shape for one block of [`Engine::process`]: `in_channels` slices of
+/// `frames` samples back to back in `inputs`; the outputs, passed beside it, are
+/// `out_channels` such slices.
+#[derive(Clone, Copy)]
+pub(crate) struct BlockIo<'a> {
+    pub frames: usize,
+    pub inputs: &'a [f64],
+    pub in_channels: usize,
+    pub out_channels: usize,
 }
 
 pub(crate) use crate::kernels::links::{Group, Interactions};
@@ -200,14 +203,11 @@ pub struct Engine {
 /// instruction set's `#[target_feature]` entry point, and with it the whole sample loop.
 struct Block<'a> {
     engine: &'a mut Engine,
-    /// The samples `start..end` of a block of `frames`.
+    /// The samples `start..end` of the block.
     start: usize,
     end: usize,
-    frames: usize,
-    inputs: &'a [f64],
-    in_channels: usize,
+    io: BlockIo<'a>,
     outputs: &'a mut [f64],
-    out_channels: usize,
 }
 
 impl pulp::WithSimd for Block<'_> {
@@ -215,14 +215,7 @@ impl pulp::WithSimd for Block<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) -> usize {
-        self.engine.run(
-            self.start..self.end,
-            self.frames,
-            self.inputs,
-            self.in_channels,
-            self.outputs,
-            self.out_channels,
-        )
+        self.engine.run(self.start..self.end, self.io, self.outputs)
     }
 }
 
@@ -568,25 +561,17 @@ impl Engine {
             if self.rest != Rest::Moving && !quiet(self) {
                 self.rest = Rest::Moving;
             }
+            let io = BlockIo {
+                frames,
+                inputs,
+                in_channels,
+                out_channels,
+            };
             let block = |engine: &mut Engine, outputs: &mut [f64], start: usize, end: usize| {
                 if engine.native_fits && engine.motion.is_none() {
-                    return engine.run_native(
-                        start..end,
-                        frames,
-                        inputs,
-                        in_channels,
-                        outputs,
-                        out_channels,
-                    );
+                    return engine.run_native(start..end, io, outputs);
                 }
-                engine.run_interpreted(
-                    start..end,
-                    frames,
-                    inputs,
-                    in_channels,
-                    outputs,
-                    out_channels,
-                )
+                engine.run_interpreted(start..end, io, outputs)
             };
             let mut start = 0;
             if self.rest == Rest::Still && frames > 0 {
@@ -625,21 +610,15 @@ impl Engine {
     pub(crate) fn run_interpreted(
         &mut self,
         samples: std::ops::Range<usize>,
-        frames: usize,
-        inputs: &[f64],
-        in_channels: usize,
+        io: BlockIo<'_>,
         outputs: &mut [f64],
-        out_channels: usize,
     ) -> usize {
         self.arch.dispatch(Block {
             start: samples.start,
             end: samples.end,
             engine: self,
-            frames,
-            inputs,
-            in_channels,
+            io,
             outputs,
-            out_channels,
         })
     }
 
@@ -653,18 +632,9 @@ impl Engine {
     fn run(
         &mut self,
         samples: std::ops::Range<usize>,
-        frames: usize,
-        inputs: &[f64],
-        in_channels: usize,
+        io: BlockIo<'_>,
         outputs: &mut [f64],
-        out_channels: usize,
     ) -> usize {
-        let io = BlockIo {
-            frames,
-            inputs,
-            in_channels,
-            out_channels,
-        };
         let scale = self.class_factors();
         let mut n = samples.start;
         let frames_end = samples.end;

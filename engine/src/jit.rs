@@ -40,7 +40,7 @@
 //! engine drop. Where Cranelift has no back end for the CPU, or the system refuses executable
 //! memory, the model runs on the interpreter.
 
-use crate::engine::{Engine, FLUSH_INTERVAL};
+use crate::engine::{BlockIo, Engine, FLUSH_INTERVAL};
 use cranelift_codegen::isa::OwnedTargetIsa;
 use cranelift_codegen::settings::{self, Configurable};
 use cranelift_jit::JITModule;
@@ -218,12 +218,15 @@ impl Engine {
     pub(crate) fn run_native(
         &mut self,
         samples: std::ops::Range<usize>,
-        frames: usize,
-        inputs: &[f64],
-        in_channels: usize,
+        io: BlockIo<'_>,
         outputs: &mut [f64],
-        out_channels: usize,
     ) -> usize {
+        let BlockIo {
+            frames,
+            inputs,
+            in_channels,
+            out_channels,
+        } = io;
         let Some(entry) = self.native.as_ref().map(|code| code.entry) else {
             return 0;
         };
@@ -265,14 +268,7 @@ impl Engine {
                 // it, flushes and guards.
                 let k = (result & !BAIL) as usize;
                 self.samples_since_reset += (k - n) as u64;
-                let ran = self.run_interpreted(
-                    k..k + 1,
-                    frames,
-                    inputs,
-                    in_channels,
-                    outputs,
-                    out_channels,
-                );
+                let ran = self.run_interpreted(k..k + 1, io, outputs);
                 if self.guard.is_some() {
                     return ran;
                 }
