@@ -36,6 +36,9 @@ pub(crate) struct MeshMacro {
     /// Whether every row's first and last nodes are pinned (a closed mesh): the row sweep
     /// then leaves them to the pinning instead of moving them first.
     pub sides_pinned: bool,
+    /// Whether every node of the first and last rows is pinned (a closed mesh): the row sweep
+    /// then only computes their drives.
+    pub ends_pinned: bool,
     pub slots: MacroSlots,
     /// K and Z of the previous sample, (0, 0) before the first: the row sweep computes the
     /// previous sample's link forces with them ([`mesh_step_rows`]).
@@ -57,12 +60,15 @@ impl MeshMacro {
         let is_pinned = |i: usize| pinned.binary_search(&(i as u32)).is_ok();
         let sides_pinned = width > 0
             && (0..length).all(|r| is_pinned(r * width) && is_pinned(r * width + width - 1));
+        let last = length.saturating_sub(1) * width;
+        let ends_pinned = length > 0 && (0..width).all(|j| is_pinned(j) && is_pinned(last + j));
         MeshMacro {
             base,
             length,
             width,
             pinned,
             sides_pinned,
+            ends_pinned,
             slots,
             last_kz: (0.0, 0.0),
         }
