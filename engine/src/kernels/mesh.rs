@@ -216,12 +216,12 @@ fn drives(law: &Stencil, x: &[f64], xp: &[f64], y: &mut [f64]) {
 /// of the row two above).
 #[inline(always)]
 fn ring_rows(ring: &mut [f64], w: usize, row: usize) -> (&[f64], &[f64], &mut [f64]) {
-    let (r0, rest) = ring.split_at_mut(w);
+    let (r0, rest) = ring[..3 * w].split_at_mut(w);
     let (r1, r2) = rest.split_at_mut(w);
     match row % 3 {
-        0 => (r2, r0, &mut r1[..]),
-        1 => (r0, r1, &mut r2[..w]),
-        _ => (r1, &r2[..w], r0),
+        0 => (r2, r0, r1),
+        1 => (r0, r1, r2),
+        _ => (r1, r2, r0),
     }
 }
 
@@ -402,6 +402,15 @@ mod tests {
     use super::*;
     use crate::engine::MacroSlots;
 
+    /// The argument slots of the tests' meshes: `args` is [M, K, K2, Z, Zo].
+    const SLOTS: MacroSlots = MacroSlots {
+        m: 0,
+        k: 1,
+        k2: 2,
+        z: 3,
+        zo: 4,
+    };
+
     /// Both schedules, from the same irregular state, agree within rounding for 200 samples,
     /// on a free mesh, a corner-pinned one and a closed one, of several shapes (macros have
     /// both sizes ≥ 2), with forces spread onto some nodes between samples (stage 5) and K
@@ -441,14 +450,7 @@ mod tests {
             c
         };
         for (sides, pinned) in [(false, vec![]), (len == 2, corners), (true, closed)] {
-            let slots = MacroSlots {
-                m: 0,
-                k: 1,
-                k2: 2,
-                z: 3,
-                zo: 4,
-            };
-            let mut mac = MeshMacro::new(0, len, w, pinned, slots);
+            let mut mac = MeshMacro::new(0, len, w, pinned, SLOTS);
             assert_eq!(mac.sides_pinned, sides, "{len}×{w}");
             let start = |seed: f64| -> Vec<f64> {
                 (0..n)
@@ -519,14 +521,7 @@ mod tests {
     #[test]
     fn a_mesh_at_rest_stays_at_rest() {
         let (len, w) = (9, 13);
-        let slots = MacroSlots {
-            m: 0,
-            k: 1,
-            k2: 2,
-            z: 3,
-            zo: 4,
-        };
-        let mut mac = MeshMacro::new(0, len, w, vec![], slots);
+        let mut mac = MeshMacro::new(0, len, w, vec![], SLOTS);
         let (mut x, mut xp) = (vec![0.3711; len * w], vec![0.3711; len * w]);
         let mut scratch = vec![0.0; SCRATCH_ROWS * w];
         for _ in 0..10 {

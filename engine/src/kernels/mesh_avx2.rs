@@ -29,8 +29,10 @@ unsafe fn st(s: &mut [f64], j: usize, v: __m256d) {
     unsafe { _mm256_storeu_pd(s.as_mut_ptr().add(j), v) }
 }
 
-/// Columns 1 … 4m of a row (m = ⌊(W − 2)/4⌋), as `inner_row`'s loop computes them. Returns
-/// the first column left to the scalar loop.
+/// Columns 1 … W − 2 of a row as `inner_row`'s loop computes them, up to the last whole
+/// vector: the up to three columns before the first aligned vector through
+/// [`inner_column`](super::mesh::inner_column), then four at a time. Returns the first column
+/// left to the scalar loop.
 ///
 /// # Safety
 /// The CPU has AVX2, and the slices are W long, W ≥ 3.
@@ -65,7 +67,7 @@ pub(super) unsafe fn inner_columns<const EXT: bool>(
     }
     let end = start + (w.saturating_sub(1 + start) / 4) * 4;
     // SAFETY: AVX2 is there (the caller's contract); every access touches columns j − 1 …
-    // j + 4 with j ≥ 1 and j + 4 ≤ end ≤ W − 1, inside the rows.
+    // j + 4 with j ≥ start ≥ 1 and j + 4 ≤ end ≤ W − 1, inside the rows.
     unsafe {
         let (a, b) = (_mm256_set1_pd(law.a), _mm256_set1_pd(law.b));
         let (k, z) = (_mm256_set1_pd(law.k), _mm256_set1_pd(law.z));
