@@ -82,13 +82,15 @@ impl<'a> Cx<'a> {
             g.mark_varying(&audio_slots, &slot_class);
             longest_chain = longest_chain.max(g.longest_chain());
         }
+        let mut singles = bound.singles;
+        singles.force_set = interactions.find_setters(singles.len(), total);
         let control = ControlArgs::new(
             self.control_bindings,
             &self.program,
             params.values.len(),
             &self.args,
-            bound.singles.cols,
-            bound.singles.len(),
+            singles.cols,
+            singles.len(),
             proxies.coord_slots.iter().flatten().copied(),
         );
         let mut macros = bound.macros;
@@ -103,7 +105,7 @@ impl<'a> Cx<'a> {
                 s: vec![0.0; longest_chain],
             },
             args: self.args,
-            singles: bound.singles,
+            singles,
             macros,
             proxies,
             interactions,

@@ -77,8 +77,9 @@ impl<'a> Cx<'a> {
             gravity: vec![0.0; n_single],
             fixed: vec![false; n_single],
             audio: vec![false; n_single],
+            force_set: vec![false; n_single],
             cols,
-            runs: vec![(0, 0, Update::General); n_single],
+            runs: vec![(0, 0, Update::General, true); n_single],
             num_runs: 0,
         };
         let mut audio_masses = Vec::new();

@@ -34,6 +34,11 @@ pub(crate) struct Group {
     /// Per chain starting rows: every row is uniform with the same arguments, so the rows
     /// run as one loop ([`Group::find_uniform`]).
     pub rows_uniform: Vec<bool>,
+    /// Per chain: the band is the first interaction of stage 4 to write the force of each of
+    /// its points, all single masses, so it sets their F instead of adding to the +0 the mass
+    /// pass would have left, and the mass pass does not clear them
+    /// ([`Interactions::find_setters`]). The bits are the same: F + s with F = +0 is 0.0 + s.
+    pub sets: Vec<bool>,
 }
 
 /// The shortest run of links [`Group::apply`] runs as a chain.
@@ -62,6 +67,7 @@ impl Group {
         self.varying = vec![false; self.chains.len()];
         self.rows = vec![0; self.chains.len()];
         self.rows_uniform = vec![false; self.chains.len()];
+        self.sets = vec![false; self.chains.len()];
     }
 
     /// Finds the rows of meshes written element by element (done once, when the model is
@@ -170,11 +176,9 @@ impl Group {
     /// F₁ −= f, F₂ += f, link by link in list order.
     ///
     /// A band (links (q + j, q + j + d), j = 0..m) runs as contiguous loops that vectorise:
-    /// the forces s_j, then every point's sum. Point q + t receives +s_{t−d} (as the second
-    /// end of link t − d, when d ≤ t < m + d) and then −s_t (as the first end of link t, when
-    /// t < m), in that order in the list and nothing else within the band, so
-    /// F ← (F + s_{t−d}) − s_t is the link-by-link scatter's arithmetic exactly; the
-    /// scatter's store-to-load chain through shared points is gone.
+    /// the forces s_j, then every point's sum ([`forward_sums`], [`reversed_sums`]), the
+    /// link-by-link scatter's arithmetic exactly without its store-to-load chain through
+    /// shared points. A band that [`Group::sets`] its points' forces does not read them.
     #[inline(always)]
     fn apply(&self, p: &mut Points, law: impl Fn(usize, f64, f64) -> f64) {
         let n = self.len();
@@ -188,6 +192,7 @@ impl Group {
             let (start, len, d) = self.chains[c];
             let (start, m, d) = (start as usize, len as usize, d as usize);
             let uniform = self.uniform.get(c).copied().unwrap_or(false);
+            let sets = self.sets.get(c).copied().unwrap_or(false);
             scatter(i, &a[i..start], &b[i..start], x, xp, f, &law);
             let q = a[start] as usize;
             if self.rows_uniform.get(c).copied().unwrap_or(false) {
@@ -205,22 +210,20 @@ impl Group {
                 for r in 1..rows {
                     s[r * w - 1] = 0.0;
                 }
+                // A rows block sets its forces only if all its rows do (`find_setters`).
                 let fs = &mut f[q..q + total + 1];
-                fs[0] -= s[0];
-                let (both, s_before, s_now) = (&mut fs[1..total], &s[..total - 1], &s[1..total]);
-                for t in 0..total - 1 {
-                    both[t] = (both[t] + s_before[t]) - s_now[t];
+                if sets {
+                    forward_sums::<true>(fs, s, total, 1);
+                } else {
+                    forward_sums::<false>(fs, s, total, 1);
                 }
-                fs[total] += s[total - 1];
                 i = start + rows * m;
                 c += rows;
                 continue;
             }
             if self.reversed.get(c).copied().unwrap_or(false) {
                 // Link j = (q + j + d, q + j), q its lower point: Δx = x[q + j + d] − x[q + j],
-                // F[q + j + d] −= s_j, F[q + j] += s_j. Point q + t receives −s_{t−d} (first
-                // end of link t − d) and then +s_t (second end of link t), in list order:
-                // F ← (F − s_{t−d}) + s_t, the scatter's arithmetic.
+                // F[q + j + d] −= s_j, F[q + j] += s_j.
                 let q = b[start] as usize;
                 let (xl, xh) = (&x[q..q + m], &x[q + d..q + d + m]);
                 let (xpl, xph) = (&xp[q..q + m], &xp[q + d..q + d + m]);
@@ -236,18 +239,10 @@ impl Group {
                     &law,
                 );
                 let fs = &mut f[q..q + m + d];
-                for t in 0..m.min(d) {
-                    fs[t] += s[t];
-                }
-                if m > d {
-                    let (both, s_before) = (&mut fs[d..m], &s[..m - d]);
-                    let s_now = &s[d..m];
-                    for t in 0..m - d {
-                        both[t] = (both[t] - s_before[t]) + s_now[t];
-                    }
-                }
-                for t in m.max(d)..m + d {
-                    fs[t] -= s[t - d];
+                if sets {
+                    reversed_sums::<true>(fs, s, m, d);
+                } else {
+                    reversed_sums::<false>(fs, s, m, d);
                 }
                 i = start + m;
                 c += 1;
@@ -257,7 +252,12 @@ impl Group {
             let (xpa, xpb) = (&xp[q..q + m], &xp[q + d..q + d + m]);
             if m >= 2 * TILE && d <= TILE {
                 let fs = &mut f[q..q + m + d];
-                forward_band_tiled(start, m, d, uniform, xa, xb, xpa, xpb, fs, scratch, &law);
+                let band = (start, m, d, uniform);
+                if sets {
+                    forward_band_tiled::<true>(band, xa, xb, xpa, xpb, fs, scratch, &law);
+                } else {
+                    forward_band_tiled::<false>(band, xa, xb, xpa, xpb, fs, scratch, &law);
+                }
                 i = start + m;
                 c += 1;
                 continue;
@@ -274,18 +274,10 @@ impl Group {
                 &law,
             );
             let fs = &mut f[q..q + m + d];
-            for t in 0..m.min(d) {
-                fs[t] -= s[t];
-            }
-            if m > d {
-                let (both, s_before) = (&mut fs[d..m], &s[..m - d]);
-                let s_now = &s[d..m];
-                for t in 0..m - d {
-                    both[t] = (both[t] + s_before[t]) - s_now[t];
-                }
-            }
-            for t in m.max(d)..m + d {
-                fs[t] += s[t - d];
+            if sets {
+                forward_sums::<true>(fs, s, m, d);
+            } else {
+                forward_sums::<false>(fs, s, m, d);
             }
             i = start + m;
             c += 1;
@@ -334,11 +326,8 @@ fn band_forces(
 /// s_{j0−d} … s_{j0−1} and the tile writes s_{j0} … s_{j1−1} after them.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn forward_band_tiled(
-    start: usize,
-    m: usize,
-    d: usize,
-    uniform: bool,
+fn forward_band_tiled<const SET: bool>(
+    (start, m, d, uniform): (usize, usize, usize, bool),
     xa: &[f64],
     xb: &[f64],
     xpa: &[f64],
@@ -367,11 +356,11 @@ fn forward_band_tiled(
         let head = d.saturating_sub(j0).min(len);
         let fs_tile = &mut fs[j0..j0 + len];
         for t in 0..head {
-            fs_tile[t] -= w[d + t];
+            fs_tile[t] = held::<SET>(fs_tile[t]) - w[d + t];
         }
         let (both, before, now) = (&mut fs_tile[head..], &w[head..len], &w[d + head..d + len]);
         for t in 0..both.len() {
-            both[t] = (both[t] + before[t]) - now[t];
+            both[t] = (held::<SET>(both[t]) + before[t]) - now[t];
         }
         // The window's last d forces lead the next tile's.
         w.copy_within(len..len + d, 0);
@@ -380,7 +369,61 @@ fn forward_band_tiled(
     // Points m … m + d − 1 only gain s_{t−d}: the window holds s_{m−d} … s_{m−1}.
     let tail = &mut fs[m..m + d];
     for t in 0..d {
-        tail[t] += w[t];
+        tail[t] = held::<SET>(tail[t]) + w[t];
+    }
+}
+
+/// The force a band adds its links' forces to: the point's F, or with `SET` (the band is the
+/// first to write it this sample, [`Group::sets`]) the +0 the mass pass used to leave there,
+/// without reading F.
+#[inline(always)]
+fn held<const SET: bool>(f: f64) -> f64 {
+    if SET {
+        0.0
+    } else {
+        f
+    }
+}
+
+/// Adds a forward band's link forces `s` (links j = (q + j, q + j + d), j < m) to its points'
+/// forces `fs` (points q … q + m + d − 1): point q + t receives +s_{t−d} (as the second end of
+/// link t − d, when d ≤ t < m + d) and then −s_t (as the first end of link t, when t < m), in
+/// that order in the list and nothing else within the band, so F ← (F + s_{t−d}) − s_t is the
+/// link-by-link scatter's arithmetic exactly.
+#[inline(always)]
+fn forward_sums<const SET: bool>(fs: &mut [f64], s: &[f64], m: usize, d: usize) {
+    let (fs, s) = (&mut fs[..m + d], &s[..m]);
+    for t in 0..m.min(d) {
+        fs[t] = held::<SET>(fs[t]) - s[t];
+    }
+    if m > d {
+        let (both, s_before, s_now) = (&mut fs[d..m], &s[..m - d], &s[d..m]);
+        for t in 0..m - d {
+            both[t] = (held::<SET>(both[t]) + s_before[t]) - s_now[t];
+        }
+    }
+    for t in m.max(d)..m + d {
+        fs[t] = held::<SET>(fs[t]) + s[t - d];
+    }
+}
+
+/// [`forward_sums`] of a reversed band (link j = (q + j + d, q + j), q its lower point):
+/// point q + t receives −s_{t−d} (first end of link t − d) and then +s_t (second end of link
+/// t), in list order: F ← (F − s_{t−d}) + s_t, the scatter's arithmetic.
+#[inline(always)]
+fn reversed_sums<const SET: bool>(fs: &mut [f64], s: &[f64], m: usize, d: usize) {
+    let (fs, s) = (&mut fs[..m + d], &s[..m]);
+    for t in 0..m.min(d) {
+        fs[t] = held::<SET>(fs[t]) + s[t];
+    }
+    if m > d {
+        let (both, s_before, s_now) = (&mut fs[d..m], &s[..m - d], &s[d..m]);
+        for t in 0..m - d {
+            both[t] = (held::<SET>(both[t]) - s_before[t]) + s_now[t];
+        }
+    }
+    for t in m.max(d)..m + d {
+        fs[t] = held::<SET>(fs[t]) - s[t - d];
     }
 }
 
@@ -471,6 +514,71 @@ impl Interactions {
             &mut self.pluck,
             &mut self.bow,
         ]
+    }
+
+    /// Finds the bands that set their points' forces ([`Group::sets`]), done once when the
+    /// model is compiled, and returns, per single mass (points `0..singles` of `num_points`),
+    /// whether a band sets its force ([`SingleMasses::force_set`](super::masses::SingleMasses)).
+    ///
+    /// Stage 4 is walked in [`Interactions::step`]'s order, group by group and, within a
+    /// group, as [`Group::apply`] runs it: the links before a band one by one, then the band.
+    /// A band sets its forces when every point it writes is a single mass (whose F the mass
+    /// pass would clear to +0) that nothing before it in stage 4 has written. A mesh's rows
+    /// run as one loop, so they set their forces only if every row does. Everything after
+    /// the bands in a sample (the later links, the force inputs, the connection points'
+    /// spreading) adds to F as before, and the mass pass reads F as before.
+    pub fn find_setters(&mut self, singles: usize, num_points: usize) -> Vec<bool> {
+        let mut written = vec![false; num_points];
+        let mut set = vec![false; singles];
+        for g in self.groups_mut() {
+            let mut i = 0;
+            for c in 0..g.chains.len() {
+                let (start, m, d) = g.chains[c];
+                let (start, m, d) = (start as usize, m as usize, d as usize);
+                for k in i..start {
+                    written[g.a[k] as usize] = true;
+                    written[g.b[k] as usize] = true;
+                }
+                // The band's points: its links' first ends q … q + m − 1 and second ends
+                // q + d … q + d + m − 1, q its lower point.
+                let q = if g.reversed[c] {
+                    g.b[start]
+                } else {
+                    g.a[start]
+                } as usize;
+                let points = (q..q + m).chain(q + d..q + d + m);
+                g.sets[c] = points.clone().all(|p| p < singles && !written[p]);
+                for p in points {
+                    written[p] = true;
+                }
+                i = start + m;
+            }
+            for k in i..g.len() {
+                written[g.a[k] as usize] = true;
+                written[g.b[k] as usize] = true;
+            }
+            let mut c = 0;
+            while c < g.chains.len() {
+                let rows = (g.rows[c] as usize).max(1);
+                let all = g.sets[c..c + rows].iter().all(|&s| s);
+                g.sets[c..c + rows].fill(all);
+                c += rows;
+            }
+            for (c, &(start, m, d)) in g.chains.iter().enumerate() {
+                if g.sets[c] {
+                    let q = if g.reversed[c] {
+                        g.b[start as usize]
+                    } else {
+                        g.a[start as usize]
+                    };
+                    let (q, m, d) = (q as usize, m as usize, d as usize);
+                    for p in (q..q + m).chain(q + d..q + d + m) {
+                        set[p] = true;
+                    }
+                }
+            }
+        }
+        set
     }
 
     /// [`Group::find_uniform`] for every group.

@@ -25,12 +25,17 @@ pub(crate) struct SingleMasses {
     pub fixed: Vec<bool>,
     /// Masses whose coefficients follow audio-rate arguments: never run as plain.
     pub audio: Vec<bool>,
+    /// Masses whose force a band of links sets in stage 4 rather than adds to
+    /// ([`Interactions::find_setters`](super::links::Interactions::find_setters)): the mass
+    /// pass leaves their F as it is instead of clearing it, since the band overwrites it
+    /// before anything else reads or adds to it.
+    pub force_set: Vec<bool>,
     /// Argument columns in `Engine::args`: M, K, Z, gravity.
     pub cols: [usize; 4],
-    /// Runs of points as (start, len, update), `runs[..num_runs]`, from
+    /// Runs of points as (start, len, update, clear F), `runs[..num_runs]`, from
     /// [`SingleMasses::classify`] (sized for the worst case as a length: `clone` keeps
     /// lengths, not capacities).
-    pub runs: Vec<(u32, u32, Update)>,
+    pub runs: Vec<(u32, u32, Update, bool)>,
     pub num_runs: usize,
 }
 
@@ -81,20 +86,27 @@ impl SingleMasses {
             && self.gravity[i].to_bits() == 0
     }
 
-    /// Splits the points into runs of plain and general updates. Never allocates once
-    /// `runs` has its length (one run per point at worst).
+    /// Whether point `i`'s force is set by a band (see [`SingleMasses::force_set`]).
+    fn is_force_set(&self, i: usize) -> bool {
+        self.force_set.get(i).copied().unwrap_or(false)
+    }
+
+    /// Splits the points into runs of plain and general updates, and of forces to clear or
+    /// to leave for a band to set. Never allocates once `runs` has its length (one run per
+    /// point at worst).
     pub fn classify(&mut self) {
         let n = self.len();
         if self.runs.len() < n {
             // Only when the model is built (or for a default value).
-            self.runs.resize(n, (0, 0, Update::General));
+            self.runs.resize(n, (0, 0, Update::General, true));
         }
         self.num_runs = 0;
         let mut i = 0;
         while i < n {
             let plain = self.is_plain(i);
+            let set = self.is_force_set(i);
             let mut end = i + 1;
-            while end < n && self.is_plain(end) == plain {
+            while end < n && self.is_plain(end) == plain && self.is_force_set(end) == set {
                 end += 1;
             }
             let first = self.inv_m[i].to_bits();
@@ -105,7 +117,7 @@ impl SingleMasses {
             } else {
                 Update::Plain
             };
-            self.runs[self.num_runs] = (i as u32, (end - i) as u32, update);
+            self.runs[self.num_runs] = (i as u32, (end - i) as u32, update, !set);
             self.num_runs += 1;
             i = end;
         }
@@ -123,40 +135,67 @@ impl SingleMasses {
             &self.gravity[..n],
             &self.inv_m[..n],
         );
-        for &(start, len, update) in &self.runs[..self.num_runs] {
+        for &(start, len, update, clear) in &self.runs[..self.num_runs] {
             let r = start as usize..(start + len) as usize;
-            let (x, xp, f, inv_m) = (
-                &mut x[r.clone()],
-                &mut xp[r.clone()],
-                &mut f[r.clone()],
+            let coefficients = (
+                &a[r.clone()],
+                &b[r.clone()],
+                &g[r.clone()],
                 &inv_m[r.clone()],
             );
-            match update {
-                Update::PlainUniform => {
-                    let inv_m = inv_m[0];
-                    for i in 0..x.len() {
-                        let next = (2.0 * x[i] - xp[i]) + f[i] * inv_m;
-                        xp[i] = x[i];
-                        x[i] = next;
-                        f[i] = 0.0;
-                    }
+            let (x, xp, f) = (&mut x[r.clone()], &mut xp[r.clone()], &mut f[r]);
+            if clear {
+                run::<true>(update, x, xp, f, coefficients);
+            } else {
+                run::<false>(update, x, xp, f, coefficients);
+            }
+        }
+    }
+}
+
+/// One run of [`SingleMasses::step`]: every point moves with `update`, and with `CLEAR` its
+/// force is cleared for stage 4 to add to (a run whose forces a band sets keeps them: see
+/// [`SingleMasses::force_set`]).
+#[inline(always)]
+fn run<const CLEAR: bool>(
+    update: Update,
+    x: &mut [f64],
+    xp: &mut [f64],
+    f: &mut [f64],
+    (a, b, g, inv_m): (&[f64], &[f64], &[f64], &[f64]),
+) {
+    let n = x.len();
+    let (xp, f, inv_m) = (&mut xp[..n], &mut f[..n], &inv_m[..n]);
+    match update {
+        Update::PlainUniform => {
+            let inv_m = inv_m[0];
+            for i in 0..n {
+                let next = (2.0 * x[i] - xp[i]) + f[i] * inv_m;
+                xp[i] = x[i];
+                x[i] = next;
+                if CLEAR {
+                    f[i] = 0.0;
                 }
-                Update::Plain => {
-                    for i in 0..x.len() {
-                        let next = (2.0 * x[i] - xp[i]) + f[i] * inv_m[i];
-                        xp[i] = x[i];
-                        x[i] = next;
-                        f[i] = 0.0;
-                    }
+            }
+        }
+        Update::Plain => {
+            for i in 0..n {
+                let next = (2.0 * x[i] - xp[i]) + f[i] * inv_m[i];
+                xp[i] = x[i];
+                x[i] = next;
+                if CLEAR {
+                    f[i] = 0.0;
                 }
-                Update::General => {
-                    let (a, b, g) = (&a[r.clone()], &b[r.clone()], &g[r]);
-                    for i in 0..x.len() {
-                        let next = a[i] * x[i] + b[i] * xp[i] + (f[i] - g[i]) * inv_m[i];
-                        xp[i] = x[i];
-                        x[i] = next;
-                        f[i] = 0.0;
-                    }
+            }
+        }
+        Update::General => {
+            let (a, b, g) = (&a[..n], &b[..n], &g[..n]);
+            for i in 0..n {
+                let next = a[i] * x[i] + b[i] * xp[i] + (f[i] - g[i]) * inv_m[i];
+                xp[i] = x[i];
+                x[i] = next;
+                if CLEAR {
+                    f[i] = 0.0;
                 }
             }
         }

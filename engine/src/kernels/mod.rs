@@ -310,9 +310,7 @@ mod tests {
             let spec = parse(&text).spec.expect("parses");
             let mut fast = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
             let mut slow = fast.clone();
-            for g in slow.interactions.groups_mut() {
-                g.chains.clear();
-            }
+            scatter_only(&mut slow);
             let frames = 512;
             let mut input = vec![0.0; frames];
             input[0] = -0.01;
@@ -395,7 +393,7 @@ mod tests {
                 .any(|r| r.2 != Update::General && (r.0..r.0 + r.1).contains(&8));
             assert_eq!(plain_osc, value == 0.0, "{:?}", runs(&fast));
             let n = general.singles.len() as u32;
-            general.singles.runs[0] = (0, n, Update::General);
+            general.singles.runs[0] = (0, n, Update::General, true);
             general.singles.num_runs = 1;
             fast.process(frames, &input, &mut a);
             general.process(frames, &input, &mut b);
@@ -442,7 +440,7 @@ mod tests {
         let spec = parse(&text).spec.expect("parses");
         let mut chained = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
         let mut reference = chained.clone();
-        reference.interactions.linear.chains.clear();
+        scatter_only(&mut reference);
         reference.interactions.linear.uniform.clear();
         let k2 = chained.param_id("K2").unwrap();
         let frames = 1024;
@@ -471,6 +469,83 @@ mod tests {
         assert_eq!(bits(chained.positions()), bits(reference.positions()));
     }
 
+    /// The reference for the bands: every link one by one, adding to forces the mass pass
+    /// clears (no band sets its points' forces).
+    fn scatter_only(e: &mut crate::Engine) {
+        for g in e.interactions.groups_mut() {
+            g.chains.clear();
+            g.sets.clear();
+        }
+        e.singles.force_set.fill(false);
+        e.singles.classify();
+    }
+
+    /// A band that is the first of stage 4 to write its points' forces sets them, and their
+    /// masses do not clear them; a band whose points an earlier one writes adds to them. Both
+    /// give the bits of [`scatter_only`] (as every model of the tests above does).
+    #[test]
+    fn bands_set_the_forces_they_write_first() {
+        // Returns each band's `sets` and how many masses leave their force to a band.
+        let check = |text: &str| {
+            let spec = parse(text).spec.expect("parses");
+            let mut e = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
+            let sets = e.interactions.linear.sets.clone();
+            let set_masses = e.singles.force_set.iter().filter(|&&s| s).count();
+            let mut reference = e.clone();
+            scatter_only(&mut reference);
+            let frames = 1024;
+            let mut input = vec![0.0; frames];
+            input[0] = -0.01;
+            let (mut a, mut b) = (vec![0.0; 2 * frames], vec![0.0; 2 * frames]);
+            e.process(frames, &input, &mut a);
+            reference.process(frames, &input, &mut b);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert!(a.iter().any(|v| v.abs() > 1e-6));
+            assert_eq!(bits(&a), bits(&b));
+            assert_eq!(bits(e.forces()), bits(reference.forces()));
+            (sets, set_masses)
+        };
+        let string = |extra: &str| {
+            let mut text = String::from("@g0 ground 0.\n@g1 ground 0.\n");
+            for i in 0..40 {
+                text += &format!("@m{i} mass 1. 0. 0.\n");
+            }
+            text += "@l0 springDamper @g0 @m0 0.1 0.001\n";
+            for i in 0..39 {
+                text += &format!("@l{} springDamper @m{i} @m{} 0.1 0.001\n", i + 1, i + 1);
+            }
+            text + "@l40 springDamper @m39 @g1 0.1 0.001\n" + extra
+        };
+        let io = "@in1 frcInput @m7\n@out1 posOutput @m25\n@out2 frcOutput @m25\n";
+        // The string's 40 masses (its end links, to grounds, are not in the band).
+        assert_eq!(check(&(string("") + io)), (vec![true], 40));
+        // Links after the band, and a contact (a later group) on its points: still set.
+        let after = "@x springDamper @m3 @m30 0.05 0.\n@c contact @m10 @m20 0.05 0.001 0.\n";
+        assert_eq!(check(&(string(after) + io)), (vec![true], 40));
+        // A 4 × 6 mesh written element by element: its rows set every node's force, and the
+        // band of links between rows (d = 6) adds to them.
+        let (len, w) = (4, 6);
+        let mut text = String::from("@g ground 0.\n");
+        for i in 0..len * w {
+            text += &format!("@m{i} mass 1. 0. 0.\n");
+        }
+        for r in 0..len {
+            for c in 0..w - 1 {
+                let i = r * w + c;
+                text += &format!("@h{i} springDamper @m{i} @m{} 0.1 0.001\n", i + 1);
+            }
+        }
+        for i in 0..(len - 1) * w {
+            text += &format!("@v{i} springDamper @m{i} @m{} 0.1 0.001\n", i + w);
+        }
+        text += "@p springDamper @g @m0 0.1 0.001\n";
+        let io = "@in1 frcInput @m7\n@out1 posOutput @m20\n@out2 frcOutput @m14\n";
+        let (sets, masses) = check(&(text + io));
+        assert_eq!(sets, [true, true, true, true, false]);
+        // The ground's link to the first node joins the first row's band: 24 nodes and it.
+        assert_eq!(masses, len * w + 1);
+    }
+
     /// Runs `text` with its chains and with the scatter only; returns whether rows of a mesh
     /// ran as one chain.
     fn chain_and_scatter_agree(text: &str, widest: u32) -> bool {
@@ -485,7 +560,7 @@ mod tests {
             "{bands:?}"
         );
         let mut reference = chained.clone();
-        reference.interactions.linear.chains.clear();
+        scatter_only(&mut reference);
         let merged = chained.interactions.linear.rows_uniform.contains(&true);
         let frames = 4096;
         let mut input = vec![0.0; frames];
