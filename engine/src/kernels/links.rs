@@ -73,13 +73,15 @@ impl Group {
     /// Finds the rows of meshes written element by element (done once, when the model is
     /// compiled): at least two chains of m links with d = 1, one after the other in the list,
     /// each starting m + 1 points after the previous one, over single masses only (points
-    /// below `singles`, whose F the mass pass resets to +0).
+    /// below `singles`, whose F is +0 when stage 4 starts: the mass pass clears it, or the
+    /// rows set it, [`Group::sets`]).
     ///
     /// Such rows run as one chain over all their points (see [`Group::apply`]) in which the
     /// links that are not there (from a row's last point to the next row's first) have force
     /// exactly +0. That changes no bit: at a row's end (F + s) − (+0) is F + s, and at the next
-    /// row's start (F + (+0)) − s is F − s because F is never −0 there (it starts at +0, and
-    /// in round-to-nearest a sum or difference is −0 only when its first operand is −0).
+    /// row's start (F + (+0)) − s is F − s because F is never −0 there (it starts at +0, or
+    /// at a force an earlier band set from +0, and in round-to-nearest a sum or difference is
+    /// −0 only when its first operand is −0).
     pub fn find_rows(&mut self, singles: usize) {
         let n = self.chains.len();
         let mut c = 0;

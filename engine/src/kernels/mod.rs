@@ -171,7 +171,7 @@ mod tests {
         };
         let render = |text: String| {
             let spec = parse(&text).spec.expect("parses");
-            let mut e = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
+            let mut e = compile(&spec, &kernels_at(44_100.0)).expect("compiles");
             let mut input = vec![0.0; 4096];
             input[0] = 1.0;
             let mut out = vec![0.0; 4096];
@@ -220,7 +220,7 @@ mod tests {
         };
         let run = |links: &[(usize, usize)]| {
             let spec = parse(&mesh(links)).spec.expect("parses");
-            let mut e = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
+            let mut e = compile(&spec, &kernels_at(48_000.0)).expect("compiles");
             let g = &e.interactions.linear;
             let banded: u32 = g.chains.iter().map(|c| c.1).sum();
             assert_eq!(banded as usize, g.len(), "every link in a band");
@@ -308,7 +308,7 @@ mod tests {
             text += &format!("@p springDamper @g @m0 0.1 0.001\n@c contact @m1 @m{} 0.05 0.001 0.\n", n - 1);
             text += &format!("@in1 frcInput @m{}\n@out1 posOutput @m{}\n", n / 3, n / 2);
             let spec = parse(&text).spec.expect("parses");
-            let mut fast = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
+            let mut fast = compile(&spec, &kernels_at(44_100.0)).expect("compiles");
             let mut slow = fast.clone();
             scatter_only(&mut slow);
             let frames = 512;
@@ -366,7 +366,7 @@ mod tests {
 @out2 frcOutput @m11
 ";
         let spec = parse(&text).spec.expect("parses");
-        let mut fast = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
+        let mut fast = compile(&spec, &kernels_at(44_100.0)).expect("compiles");
         let runs = |e: &crate::Engine| e.singles.runs[..e.singles.num_runs].to_vec();
         assert!(
             [Update::Plain, Update::PlainUniform]
@@ -438,7 +438,7 @@ mod tests {
 @out1 posOutput @m90
 ";
         let spec = parse(&text).spec.expect("parses");
-        let mut chained = compile(&spec, &CompileOptions::at(44_100.0)).expect("compiles");
+        let mut chained = compile(&spec, &kernels_at(44_100.0)).expect("compiles");
         let mut reference = chained.clone();
         scatter_only(&mut reference);
         reference.interactions.linear.uniform.clear();
@@ -469,6 +469,15 @@ mod tests {
         assert_eq!(bits(chained.positions()), bits(reference.positions()));
     }
 
+    /// Options that keep a model on the kernels: small models (up to 60 points and links)
+    /// would otherwise run on native code (`jit`), which these tests are not about.
+    fn kernels_at(sample_rate_hz: f64) -> CompileOptions {
+        CompileOptions {
+            jit: false,
+            ..CompileOptions::at(sample_rate_hz)
+        }
+    }
+
     /// The reference for the bands: every link one by one, adding to forces the mass pass
     /// clears (no band sets its points' forces).
     fn scatter_only(e: &mut crate::Engine) {
@@ -485,11 +494,18 @@ mod tests {
     /// give the bits of [`scatter_only`] (as every model of the tests above does).
     #[test]
     fn bands_set_the_forces_they_write_first() {
-        // Returns each band's `sets` and how many masses leave their force to a band.
+        // Returns each band's `sets`, group by group (the groups without bands left out),
+        // and how many masses leave their force to a band.
         let check = |text: &str| {
             let spec = parse(text).spec.expect("parses");
-            let mut e = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
-            let sets = e.interactions.linear.sets.clone();
+            let mut e = compile(&spec, &kernels_at(48_000.0)).expect("compiles");
+            let mut groups = e.interactions.clone();
+            let sets: Vec<Vec<bool>> = groups
+                .groups_mut()
+                .iter()
+                .filter(|g| !g.sets.is_empty())
+                .map(|g| g.sets.clone())
+                .collect();
             let set_masses = e.singles.force_set.iter().filter(|&&s| s).count();
             let mut reference = e.clone();
             scatter_only(&mut reference);
@@ -518,39 +534,60 @@ mod tests {
         };
         let io = "@in1 frcInput @m7\n@out1 posOutput @m25\n@out2 frcOutput @m25\n";
         // The string's 40 masses (its end links, to grounds, are not in the band).
-        assert_eq!(check(&(string("") + io)), (vec![true], 40));
+        assert_eq!(check(&(string("") + io)), (vec![vec![true]], 40));
         // Links after the band, and a contact (a later group) on its points: still set.
         let after = "@x springDamper @m3 @m30 0.05 0.\n@c contact @m10 @m20 0.05 0.001 0.\n";
-        assert_eq!(check(&(string(after) + io)), (vec![true], 40));
+        assert_eq!(check(&(string(after) + io)), (vec![vec![true]], 40));
+        // A band of contacts (a later group) over points the string's band wrote: it adds.
+        let mut contacts = String::new();
+        for i in 5..13 {
+            contacts += &format!("@c{i} contact @m{i} @m{} 0.05 0.001 0.\n", i + 1);
+        }
+        assert_eq!(
+            check(&(string(&contacts) + io)),
+            (vec![vec![true], vec![false]], 40)
+        );
         // A 4 × 6 mesh written element by element: its rows set every node's force, and the
         // band of links between rows (d = 6) adds to them.
         let (len, w) = (4, 6);
-        let mut text = String::from("@g ground 0.\n");
-        for i in 0..len * w {
-            text += &format!("@m{i} mass 1. 0. 0.\n");
-        }
-        for r in 0..len {
-            for c in 0..w - 1 {
-                let i = r * w + c;
-                text += &format!("@h{i} springDamper @m{i} @m{} 0.1 0.001\n", i + 1);
+        let mesh = |law: &str, args: &str| {
+            let mut text = String::from("@g ground 0.\n");
+            for i in 0..len * w {
+                text += &format!("@m{i} mass 1. 0. 0.\n");
             }
-        }
-        for i in 0..(len - 1) * w {
-            text += &format!("@v{i} springDamper @m{i} @m{} 0.1 0.001\n", i + w);
-        }
-        text += "@p springDamper @g @m0 0.1 0.001\n";
+            for r in 0..len {
+                for c in 0..w - 1 {
+                    let i = r * w + c;
+                    text += &format!("@h{i} {law} @m{i} @m{} {args}\n", i + 1);
+                }
+            }
+            for i in 0..(len - 1) * w {
+                text += &format!("@v{i} {law} @m{i} @m{} {args}\n", i + w);
+            }
+            text + "@p springDamper @g @m0 0.1 0.001\n"
+        };
         let io = "@in1 frcInput @m7\n@out1 posOutput @m20\n@out2 frcOutput @m14\n";
-        let (sets, masses) = check(&(text + io));
-        assert_eq!(sets, [true, true, true, true, false]);
+        let (sets, masses) = check(&(mesh("springDamper", "0.1 0.001") + io));
+        assert_eq!(sets, [vec![true, true, true, true, false]]);
         // The ground's link to the first node joins the first row's band: 24 nodes and it.
         assert_eq!(masses, len * w + 1);
+        // The same mesh of nlSpring2 links, with a string of spring-dampers (an earlier
+        // group) over its third row: that row's band cannot set, so no row does (the rows
+        // may run as one loop); only the string's band sets.
+        let mut text = mesh("nlSpring2", "0.1 0.01 0.001");
+        for i in 12..17 {
+            text += &format!("@s{i} springDamper @m{i} @m{} 0.05 0.001\n", i + 1);
+        }
+        let (sets, masses) = check(&(text + io));
+        assert_eq!(sets, [vec![true], vec![false; 5]]);
+        assert_eq!(masses, 6);
     }
 
     /// Runs `text` with its chains and with the scatter only; returns whether rows of a mesh
     /// ran as one chain.
     fn chain_and_scatter_agree(text: &str, widest: u32) -> bool {
         let spec = parse(text).spec.expect("parses");
-        let mut chained = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
+        let mut chained = compile(&spec, &kernels_at(48_000.0)).expect("compiles");
         let bands = &chained.interactions.linear.chains;
         assert!(bands.iter().any(|b| b.2 == widest), "{bands:?}");
         // Every link of these models is in a band, whichever way it is written.
