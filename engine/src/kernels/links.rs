@@ -3,6 +3,7 @@
 
 use crate::engine::Points;
 use crate::laws;
+use std::ops::Range;
 
 /// Interactions of one law: endpoint index arrays and argument columns in `Engine::args`
 /// (column c of row i is `args[cols[c] + i]`).
@@ -123,6 +124,23 @@ impl Group {
                 let classes = &class[slots.clone()];
                 audio[slots].contains(&true) || classes.iter().any(|&k| k != classes[0])
             });
+        }
+    }
+
+    /// The points band `c` writes: its links' first ends q … q + m − 1 and second ends
+    /// q + d … q + d + m − 1, q its lower point.
+    fn band_points(&self, c: usize) -> std::iter::Chain<Range<usize>, Range<usize>> {
+        let (start, m, d) = self.chains[c];
+        let lower = if self.reversed[c] { &self.b } else { &self.a };
+        let (q, m, d) = (lower[start as usize] as usize, m as usize, d as usize);
+        (q..q + m).chain(q + d..q + d + m)
+    }
+
+    /// Marks both ends of links `links` as written (see [`Interactions::find_setters`]).
+    fn mark_links(&self, links: Range<usize>, written: &mut [bool]) {
+        for k in links {
+            written[self.a[k] as usize] = true;
+            written[self.b[k] as usize] = true;
         }
     }
 
@@ -535,30 +553,13 @@ impl Interactions {
         for g in self.groups_mut() {
             let mut i = 0;
             for c in 0..g.chains.len() {
-                let (start, m, d) = g.chains[c];
-                let (start, m, d) = (start as usize, m as usize, d as usize);
-                for k in i..start {
-                    written[g.a[k] as usize] = true;
-                    written[g.b[k] as usize] = true;
-                }
-                // The band's points: its links' first ends q … q + m − 1 and second ends
-                // q + d … q + d + m − 1, q its lower point.
-                let q = if g.reversed[c] {
-                    g.b[start]
-                } else {
-                    g.a[start]
-                } as usize;
-                let points = (q..q + m).chain(q + d..q + d + m);
-                g.sets[c] = points.clone().all(|p| p < singles && !written[p]);
-                for p in points {
-                    written[p] = true;
-                }
-                i = start + m;
+                let (start, m, _) = g.chains[c];
+                g.mark_links(i..start as usize, &mut written);
+                g.sets[c] = g.band_points(c).all(|p| p < singles && !written[p]);
+                g.band_points(c).for_each(|p| written[p] = true);
+                i = (start + m) as usize;
             }
-            for k in i..g.len() {
-                written[g.a[k] as usize] = true;
-                written[g.b[k] as usize] = true;
-            }
+            g.mark_links(i..g.len(), &mut written);
             let mut c = 0;
             while c < g.chains.len() {
                 let rows = (g.rows[c] as usize).max(1);
@@ -566,18 +567,8 @@ impl Interactions {
                 g.sets[c..c + rows].fill(all);
                 c += rows;
             }
-            for (c, &(start, m, d)) in g.chains.iter().enumerate() {
-                if g.sets[c] {
-                    let q = if g.reversed[c] {
-                        g.b[start as usize]
-                    } else {
-                        g.a[start as usize]
-                    };
-                    let (q, m, d) = (q as usize, m as usize, d as usize);
-                    for p in (q..q + m).chain(q + d..q + d + m) {
-                        set[p] = true;
-                    }
-                }
+            for c in (0..g.chains.len()).filter(|&c| g.sets[c]) {
+                g.band_points(c).for_each(|p| set[p] = true);
             }
         }
         set

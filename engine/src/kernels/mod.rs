@@ -63,14 +63,7 @@ mod tests {
     /// reference, bit for bit.
     #[test]
     fn chains_equal_the_link_by_link_scatter() {
-        let mut text = String::from("@g0 ground 0.\n@g1 ground 0.\n");
-        for i in 0..40 {
-            text += &format!("@m{i} mass 1. 0. 0.\n");
-        }
-        text += "@l0 springDamper @g0 @m0 0.1 0.001\n";
-        for i in 0..39 {
-            text += &format!("@l{} springDamper @m{i} @m{} 0.1 0.001\n", i + 1, i + 1);
-        }
+        let mut text = forty_masses_from_g0();
         // A link out of the chain between two runs, and a nonlinear law on the same points.
         text += "@x springDamper @m3 @m30 0.05 0.\n@c contact @m10 @m20 0.05 0.001 0.\n";
         text += "@l40 springDamper @m39 @g1 0.1 0.001\n@in1 frcInput @m7\n@out1 posOutput @m25\n";
@@ -469,6 +462,20 @@ mod tests {
         assert_eq!(bits(chained.positions()), bits(reference.positions()));
     }
 
+    /// Grounds g0 and g1, masses m0 … m39, and the spring-dampers from g0 along the masses
+    /// to m39 (not yet to g1).
+    fn forty_masses_from_g0() -> String {
+        let mut text = String::from("@g0 ground 0.\n@g1 ground 0.\n");
+        for i in 0..40 {
+            text += &format!("@m{i} mass 1. 0. 0.\n");
+        }
+        text += "@l0 springDamper @g0 @m0 0.1 0.001\n";
+        for i in 0..39 {
+            text += &format!("@l{} springDamper @m{i} @m{} 0.1 0.001\n", i + 1, i + 1);
+        }
+        text
+    }
+
     /// Options that keep a model on the kernels: small models (up to 60 points and links)
     /// would otherwise run on native code (`jit`), which these tests are not about.
     fn kernels_at(sample_rate_hz: f64) -> CompileOptions {
@@ -521,17 +528,8 @@ mod tests {
             assert_eq!(bits(e.forces()), bits(reference.forces()));
             (sets, set_masses)
         };
-        let string = |extra: &str| {
-            let mut text = String::from("@g0 ground 0.\n@g1 ground 0.\n");
-            for i in 0..40 {
-                text += &format!("@m{i} mass 1. 0. 0.\n");
-            }
-            text += "@l0 springDamper @g0 @m0 0.1 0.001\n";
-            for i in 0..39 {
-                text += &format!("@l{} springDamper @m{i} @m{} 0.1 0.001\n", i + 1, i + 1);
-            }
-            text + "@l40 springDamper @m39 @g1 0.1 0.001\n" + extra
-        };
+        let string =
+            |extra: &str| forty_masses_from_g0() + "@l40 springDamper @m39 @g1 0.1 0.001\n" + extra;
         let io = "@in1 frcInput @m7\n@out1 posOutput @m25\n@out2 frcOutput @m25\n";
         // The string's 40 masses (its end links, to grounds, are not in the band).
         assert_eq!(check(&(string("") + io)), (vec![vec![true]], 40));
