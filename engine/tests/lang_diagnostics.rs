@@ -724,6 +724,16 @@ fn columns_count_scalar_values_and_tabs() {
     find(&p, C::ExpressionSyntax, 1, 10);
     let p = parse("@m mass 1 0 0\r\n@n mass 1 0 0\r@o mass x 0 0\n");
     find(&p, C::UndefinedName, 3, 9);
+    // Inside a bracket, after characters of two and four bytes and a no-break space.
+    let p = parse("@é mass 1 [0\u{a0}(😀) 0] 0\n");
+    find(&p, C::ExpressionSyntax, 1, 15);
+    let p = parse("@s string 5 1 0.1 0.01 0 0\n@m mass 1 0 0\n@é spring [@s\u{2003}2x] @m 0.1\n");
+    find(&p, C::InvalidNumber, 3, 15);
+    let p = parse("~generate\u{a0}string s nodes=5 M=1 K=0.1 Z=0.001 from=é,0,0\n");
+    find(&p, C::InvalidNumber, 1, 51);
+    // A legacy mesh point `u:w` after a wide label: `w` starts after the colon.
+    let p = parse("@😀 mesh 4 4 1 0.1 0.01 0 0\n@out1 posOutput @😀 0.5:y\n");
+    find(&p, C::UndefinedName, 2, 24);
 }
 
 #[test]

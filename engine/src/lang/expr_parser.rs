@@ -32,10 +32,6 @@ pub(crate) fn is_identifier(s: &str) -> bool {
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
-fn col_at(base: u32, i: usize) -> u32 {
-    base.saturating_add(u32::try_from(i).unwrap_or(u32::MAX))
-}
-
 #[derive(Clone, Debug, PartialEq)]
 enum Tok {
     Num(f64),
@@ -61,18 +57,18 @@ struct ExprParser<'a, 'd> {
     failed: bool,
 }
 
-/// Parses `chars` (whose first character stands at column `col`) as an expression. Reports every
+/// Parses `text` (whose first character stands at column `col`) as an expression. Reports every
 /// problem and returns `None` when there was any.
 pub(crate) fn parse_expression(
-    chars: &[char],
+    text: &str,
     col: u32,
     cx: &ExprContext<'_>,
     diags: &mut Diags,
 ) -> Option<Expr> {
-    if let Some(v) = plain_number(chars) {
+    if let Some(v) = plain_number(text) {
         return Some(Expr::Num(v));
     }
-    let toks = lex(chars, col, cx, diags)?;
+    let toks = lex(text, col, cx, diags)?;
     let mut p = ExprParser {
         toks,
         pos: 0,
@@ -94,80 +90,79 @@ pub(crate) fn parse_expression(
     }
 }
 
-fn lex(
-    chars: &[char],
-    col: u32,
-    cx: &ExprContext<'_>,
-    diags: &mut Diags,
-) -> Option<Vec<(Tok, u32)>> {
+/// Splits an expression into tokens. `i` is a byte offset and `at` its column: every character
+/// of a token is ASCII, and any other character is a blank (one column) or an error.
+fn lex(text: &str, col: u32, cx: &ExprContext<'_>, diags: &mut Diags) -> Option<Vec<(Tok, u32)>> {
+    let bytes = text.as_bytes();
     let mut toks = Vec::new();
     let mut i = 0;
-    while let Some(&c) = chars.get(i) {
+    let mut at = col;
+    while let Some(c) = text.get(i..).and_then(|s| s.chars().next()) {
         if is_blank(c) {
-            i += 1;
+            i += c.len_utf8();
+            at = at.saturating_add(1);
             continue;
         }
-        let at = col_at(col, i);
-        if c.is_ascii_digit() || (c == '.' && chars.get(i + 1).is_some_and(char::is_ascii_digit)) {
-            let end = scan_number(chars, i).unwrap_or(i + 1);
+        if c.is_ascii_digit() || (c == '.' && bytes.get(i + 1).is_some_and(u8::is_ascii_digit)) {
+            let end = scan_number(bytes, i).unwrap_or(i + 1);
             // A number glued to letters, digits or a dot (`40abc`, `1.2.3`, `1e`) is invalid.
-            let mut bad_end = end;
-            while chars
-                .get(bad_end)
-                .is_some_and(|c| c.is_alphanumeric() || *c == '_' || *c == '.')
-            {
-                bad_end += 1;
-            }
-            let text = chars.get(i..bad_end).unwrap_or(&[]);
-            if bad_end > end {
+            let glued = text
+                .get(end..)
+                .unwrap_or("")
+                .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == '.'))
+                .map_or(text.len(), |k| end + k);
+            let written = text.get(i..glued).unwrap_or("");
+            if glued > end {
                 diags.push(
                     Diagnostic::new(
                         DiagnosticCode::InvalidNumber,
                         cx.line,
                         at,
-                        format!("invalid number `{}`", text.iter().collect::<String>()),
+                        format!("invalid number `{written}`"),
                     )
                     .with_label(cx.label)
-                    .with_found(text.iter().collect::<String>()),
+                    .with_found(written),
                 );
                 return None;
             }
-            match to_f64(text) {
+            match to_f64(written) {
                 Ok(v) => toks.push((Tok::Num(v), at)),
                 Err(e) => {
-                    let s: String = text.iter().collect();
                     let (code, msg) = match e {
                         NumberError::NonFinite => (
                             DiagnosticCode::NonFiniteNumber,
-                            format!("non-finite number `{s}`"),
+                            format!("non-finite number `{written}`"),
                         ),
                         NumberError::Invalid => (
                             DiagnosticCode::InvalidNumber,
-                            format!("invalid number `{s}`"),
+                            format!("invalid number `{written}`"),
                         ),
                     };
                     diags.push(
                         Diagnostic::new(code, cx.line, at, msg)
                             .with_label(cx.label)
-                            .with_found(s),
+                            .with_found(written),
                     );
                     return None;
                 }
             }
+            at = at.saturating_add(u32::try_from(end - i).unwrap_or(u32::MAX));
             i = end;
         } else if c.is_ascii_alphabetic() || c == '_' {
-            let start = i;
-            while chars
-                .get(i)
-                .is_some_and(|c| c.is_ascii_alphanumeric() || *c == '_')
-            {
-                i += 1;
-            }
-            let name = super::lexer::text_of(chars.get(start..i).unwrap_or(&[]));
+            let len = bytes
+                .get(i..)
+                .unwrap_or(&[])
+                .iter()
+                .take_while(|b| b.is_ascii_alphanumeric() || **b == b'_')
+                .count();
+            let name = text.get(i..i + len).unwrap_or("").to_string();
             toks.push((Tok::Ident(name), at));
+            at = at.saturating_add(u32::try_from(len).unwrap_or(u32::MAX));
+            i += len;
         } else if matches!(c, '+' | '-' | '*' | '/' | '(' | ')' | ',') {
             toks.push((Tok::Op(c), at));
             i += 1;
+            at = at.saturating_add(1);
         } else {
             let hint = match c {
                 '@' => {
@@ -190,7 +185,7 @@ fn lex(
             return None;
         }
     }
-    toks.push((Tok::End, col_at(col, chars.len())));
+    toks.push((Tok::End, at));
     Some(toks)
 }
 
@@ -512,8 +507,7 @@ mod tests {
             label: None,
         };
         let mut d = Diags::default();
-        let chars: Vec<char> = s.chars().collect();
-        let e = parse_expression(&chars, 1, &cx, &mut d);
+        let e = parse_expression(s, 1, &cx, &mut d);
         (e, d.finish())
     }
 

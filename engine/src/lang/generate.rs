@@ -20,7 +20,7 @@
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::expr_parser::{is_identifier, parse_expression, ExprContext};
-use super::lexer::{is_blank, split_items, TokKind, Token};
+use super::lexer::{col_plus, is_blank, split_items, width, TokKind, Token};
 use super::numbers::{parse_number_literal, NumberError};
 use super::symbols::Symbols;
 use crate::generators::{
@@ -233,7 +233,7 @@ fn minimum(kind: GenKind) -> usize {
 /// A value as written: its characters and the column of the first one.
 #[derive(Clone, Debug)]
 pub(crate) struct Val {
-    chars: Vec<char>,
+    value: String,
     col: u32,
     /// Written as `key=[ … ]`.
     bracket: bool,
@@ -241,7 +241,7 @@ pub(crate) struct Val {
 
 impl Val {
     fn text(&self) -> String {
-        self.chars.iter().collect()
+        self.value.clone()
     }
 }
 
@@ -302,7 +302,7 @@ pub(crate) fn expand(
         label,
     };
     let eval = |key: &str, v: &Val, diags: &mut Diags| -> Option<f64> {
-        let e = parse_expression(&v.chars, v.col, &cx, diags)?;
+        let e = parse_expression(&v.value, v.col, &cx, diags)?;
         let mut problem: Option<String> = None;
         e.for_each_name(&mut |n| {
             if problem.is_some() {

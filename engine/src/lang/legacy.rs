@@ -22,7 +22,7 @@
 //! arguments, and a bare macro label without coordinates is still an error.
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
-use super::lexer::{is_blank, TokKind, Token};
+use super::lexer::{col_plus, width, TokKind, Token};
 use super::symbols::{SymKind, Symbols};
 
 /// A bare macro label in an endpoint slot, with the coordinate tokens that go with it.
@@ -227,7 +227,7 @@ fn macro_velocity<'a>(
     let mut out = args.to_vec();
     out.push(Token {
         kind: TokKind::Bare,
-        text: &['0'],
+        text: "0",
         col: pos.col,
         inner_col: pos.col,
     });
@@ -239,35 +239,36 @@ fn macro_velocity<'a>(
 
 /// `@label` as a bare token: the label without `@`.
 fn bare_label(t: &Token) -> Option<String> {
-    if t.kind != TokKind::Bare || t.text.first() != Some(&'@') || t.text.len() < 2 {
+    if t.kind != TokKind::Bare || !t.starts_with_at() || t.text.len() < 2 {
         return None;
     }
-    Some(t.label())
+    Some(t.label().to_string())
 }
 
 /// A token that can be a coordinate: a bare value (not a label) or a bracketed expression (not
 /// a connection point).
 fn is_coordinate(t: &Token) -> bool {
-    let first = t.text.iter().find(|c| !is_blank(**c));
+    let first = t.first_non_blank();
     match t.kind {
-        TokKind::Bare => first.is_some_and(|c| *c != '@'),
-        TokKind::Bracket => first.is_some_and(|c| *c != '@'),
+        TokKind::Bare => first.is_some_and(|c| c != '@'),
+        TokKind::Bracket => first.is_some_and(|c| c != '@'),
         TokKind::Quoted => false,
     }
 }
 
-/// The indices of the `:` of a bare token outside parentheses (the legacy mesh point `u:w`).
+/// The byte offsets of the `:` of a bare token outside parentheses (the legacy mesh point
+/// `u:w`).
 fn top_level_colons(t: &Token) -> Vec<usize> {
     if t.kind != TokKind::Bare {
         return Vec::new();
     }
     let mut depth = 0usize;
     let mut out = Vec::new();
-    for (i, c) in t.text.iter().enumerate() {
+    for (i, c) in t.text.bytes().enumerate() {
         match c {
-            '(' => depth += 1,
-            ')' => depth = depth.saturating_sub(1),
-            ':' if depth == 0 => out.push(i),
+            b'(' => depth += 1,
+            b')' => depth = depth.saturating_sub(1),
+            b':' if depth == 0 => out.push(i),
             _ => {}
         }
     }
@@ -281,12 +282,11 @@ fn split_at_colon<'a>(t: &Token<'a>, at: usize) -> Option<(Token<'a>, Token<'a>)
     if u.is_empty() || w.is_empty() {
         return None;
     }
-    let shift = |by: usize, col: u32| col.saturating_add(u32::try_from(by).unwrap_or(u32::MAX));
-    let part = |text: &'a [char], by: usize| Token {
+    let part = |text: &'a str, by: u32| Token {
         kind: TokKind::Bare,
         text,
-        col: shift(by, t.col),
-        inner_col: shift(by, t.inner_col),
+        col: col_plus(t.col, by),
+        inner_col: col_plus(t.inner_col, by),
     };
-    Some((part(u, 0), part(w, at + 1)))
+    Some((part(u, 0), part(w, width(u).saturating_add(1))))
 }

@@ -10,29 +10,19 @@ pub(crate) fn is_blank(c: char) -> bool {
 
 /// Splits `text` into lines at CR LF, CR or LF (spec §3.2). Returns (1-based line number, line).
 pub(crate) fn split_lines(text: &str) -> Vec<(u32, &str)> {
-    let mut lines = Vec::new();
     let bytes = text.as_bytes();
+    let mut lines = Vec::with_capacity(memchr::memchr_iter(b'\n', bytes).count() + 1);
     let mut start = 0;
-    let mut i = 0;
     let mut number: u32 = 1;
-    while i < bytes.len() {
-        match bytes.get(i) {
-            Some(b'\n') => {
-                lines.push((number, text.get(start..i).unwrap_or("")));
-                number = number.saturating_add(1);
-                i += 1;
-                start = i;
-            }
-            Some(b'\r') => {
-                lines.push((number, text.get(start..i).unwrap_or("")));
-                number = number.saturating_add(1);
-                i += 1;
-                if bytes.get(i) == Some(&b'\n') {
-                    i += 1;
-                }
-                start = i;
-            }
-            _ => i += 1,
+    for i in memchr::memchr2_iter(b'\n', b'\r', bytes) {
+        if i < start {
+            continue; // the LF of a CR LF
+        }
+        lines.push((number, text.get(start..i).unwrap_or("")));
+        number = number.saturating_add(1);
+        start = i + 1;
+        if bytes.get(i) == Some(&b'\r') && bytes.get(i + 1) == Some(&b'\n') {
+            start += 1;
         }
     }
     if start < bytes.len() {
@@ -52,81 +42,121 @@ pub(crate) enum TokKind {
     Quoted,
 }
 
-/// A token of a command or directive line. Its text borrows the script's characters, so
-/// reading a line allocates only the token list.
+/// A token of a command or directive line. Its text borrows the script, so reading a line
+/// allocates nothing but room in the script's token vector.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Token<'a> {
     pub kind: TokKind,
     /// The content (without brackets or quotes).
-    pub text: &'a [char],
+    pub text: &'a str,
     /// Column of the token's first character (the `[` or `'` for groups).
     pub col: u32,
     /// Column of the content's first character.
     pub inner_col: u32,
 }
 
-/// The characters as a string. ASCII text, which nearly every label and number is, is copied
-/// byte for byte rather than encoded character by character.
-pub(crate) fn text_of(chars: &[char]) -> String {
-    if chars.iter().all(char::is_ascii) {
-        let bytes: Vec<u8> = chars.iter().map(|&c| c as u8).collect();
-        String::from_utf8(bytes).unwrap_or_default()
-    } else {
-        chars.iter().collect()
-    }
-}
-
 impl Token<'_> {
     pub(crate) fn string(&self) -> String {
-        text_of(self.text)
+        self.text.to_string()
     }
 
     /// The text after the first character: a label token's label, without its `@`.
-    pub(crate) fn label(&self) -> String {
-        text_of(self.text.get(1..).unwrap_or(&[]))
+    pub(crate) fn label(&self) -> &str {
+        after_first(self.text)
     }
 
     /// The token as written in the script, for messages.
     pub(crate) fn source(&self) -> String {
         match self.kind {
             TokKind::Bare => self.string(),
-            TokKind::Bracket => format!("[{}]", self.string()),
-            TokKind::Quoted => format!("'{}'", self.string()),
+            TokKind::Bracket => format!("[{}]", self.text),
+            TokKind::Quoted => format!("'{}'", self.text),
         }
+    }
+
+    /// The first non-blank character of the content.
+    pub(crate) fn first_non_blank(&self) -> Option<char> {
+        self.text.chars().find(|c| !is_blank(*c))
+    }
+
+    /// True when the content starts with `@` (a label, not a value).
+    pub(crate) fn starts_with_at(&self) -> bool {
+        self.text.as_bytes().first() == Some(&b'@')
     }
 }
 
-fn col_of(i: usize) -> u32 {
-    u32::try_from(i.saturating_add(1)).unwrap_or(u32::MAX)
+/// `s` without its first character.
+pub(crate) fn after_first(s: &str) -> &str {
+    let mut chars = s.chars();
+    chars.next();
+    chars.as_str()
+}
+
+/// The number of columns `s` spans: its Unicode scalar values (spec §3.12 f: columns count
+/// characters, a tab as one).
+pub(crate) fn width(s: &str) -> u32 {
+    u32::try_from(s.chars().count()).unwrap_or(u32::MAX)
+}
+
+/// `col` moved right by `by` columns.
+pub(crate) fn col_plus(col: u32, by: u32) -> u32 {
+    col.saturating_add(by)
+}
+
+/// The character at byte `i` of `s` and its length in bytes; ASCII without decoding.
+#[inline]
+fn char_at(s: &str, i: usize) -> Option<(char, usize)> {
+    let b = *s.as_bytes().get(i)?;
+    if b.is_ascii() {
+        return Some((char::from(b), 1));
+    }
+    let c = s.get(i..)?.chars().next()?;
+    Some((c, c.len_utf8()))
 }
 
 fn is_bare_char(c: char) -> bool {
     !is_blank(c) && !matches!(c, '+' | '[' | ']' | '\'' | '#')
 }
 
+/// The ASCII bytes [`is_bare_char`] accepts (non-ASCII bytes are `false`: the lexer decodes
+/// their character).
+const BARE_ASCII: [bool; 256] = {
+    let mut table = [false; 256];
+    let mut b = 0;
+    while b < 128 {
+        table[b] = !matches!(b as u8, b'\t'..=b'\r' | b' ' | b'+' | b'[' | b']' | b'\'' | b'#');
+        b += 1;
+    }
+    table
+};
+
+/// The length of the run of bare ASCII bytes at the start of `bytes`.
+#[inline]
+fn bare_ascii_run(bytes: &[u8]) -> usize {
+    bytes
+        .iter()
+        .position(|&b| !BARE_ASCII[usize::from(b)])
+        .unwrap_or(bytes.len())
+}
+
 /// True when `tok` (the bare token scanned so far) ends with the mantissa of a number followed
 /// by `e`/`E`, i.e. a following `+digits` is the exponent of a numeric literal (spec §3.3).
-fn ends_with_exponent_marker(tok: &[char]) -> bool {
-    let Some((&last, rest)) = tok.split_last() else {
+fn ends_with_exponent_marker(tok: &str) -> bool {
+    let Some(rest) = tok.strip_suffix(['e', 'E']) else {
         return false;
     };
-    if last != 'e' && last != 'E' {
-        return false;
-    }
     let mantissa_len = rest
-        .iter()
+        .bytes()
         .rev()
-        .take_while(|c| c.is_ascii_digit() || **c == '.')
+        .take_while(|b| b.is_ascii_digit() || *b == b'.')
         .count();
-    let split = rest.len() - mantissa_len;
-    let (before, mantissa) = rest.split_at(split);
-    if !mantissa.iter().any(char::is_ascii_digit)
-        || mantissa.iter().filter(|c| **c == '.').count() > 1
+    let (before, mantissa) = rest.split_at(rest.len() - mantissa_len);
+    if !mantissa.bytes().any(|b| b.is_ascii_digit()) || mantissa.bytes().filter(|b| *b == b'.').count() > 1
     {
         return false;
     }
-    match before.last() {
-        Some(c) => !(c.is_alphanumeric() || *c == '_'),
+    match before.chars().next_back() {
+        Some(c) => !(c.is_alphanumeric() || c == '_'),
         None => true,
     }
 }
@@ -137,43 +167,48 @@ fn ends_with_exponent_marker(tok: &[char]) -> bool {
 /// returns `None` then, with `tokens` as it was; warns about `+` separators between two
 /// non-blank characters.
 pub(crate) fn tokenize<'a>(
-    chars: &'a [char],
+    text: &'a str,
     line: u32,
     diags: &mut Diags,
     tokens: &mut Vec<Token<'a>>,
 ) -> Option<std::ops::Range<usize>> {
     let start = tokens.len();
-    let lexed = lex_line(chars, line, diags, tokens);
+    let lexed = lex_line(text, line, diags, tokens);
     if lexed.is_none() {
         tokens.truncate(start);
     }
     lexed.map(|()| start..tokens.len())
 }
 
+/// The lexer's loop: `i` is a byte offset into the line and `col` its column, moved together
+/// (every character the lexer dispatches on is ASCII; other characters are stepped over whole).
 fn lex_line<'a>(
-    chars: &'a [char],
+    text: &'a str,
     line: u32,
     diags: &mut Diags,
     tokens: &mut Vec<Token<'a>>,
 ) -> Option<()> {
+    let bytes = text.as_bytes();
     let mut i = 0;
-    while let Some(&c) = chars.get(i) {
+    let mut col: u32 = 1;
+    while let Some((c, len)) = char_at(text, i) {
         if is_blank(c) {
-            i += 1;
+            i += len;
+            col = col_plus(col, 1);
             continue;
         }
         match c {
             '#' => break,
             '+' => {
-                let prev = i.checked_sub(1).and_then(|p| chars.get(p));
-                let next = chars.get(i + 1);
-                if let (Some(&p), Some(&n)) = (prev, next) {
+                let prev = text.get(..i).and_then(|s| s.chars().next_back());
+                let next = text.get(i + 1..).and_then(|s| s.chars().next());
+                if let (Some(p), Some(n)) = (prev, next) {
                     if !is_blank(p) && !is_blank(n) && n != '#' {
                         diags.push(
                             Diagnostic::new(
                                 DiagnosticCode::PlusSeparator,
                                 line,
-                                col_of(i),
+                                col,
                                 "`+` outside brackets separates tokens (as in MIMS4Max); \
                                  write the expression inside [ ]",
                             )
@@ -182,92 +217,105 @@ fn lex_line<'a>(
                     }
                 }
                 i += 1;
+                col = col_plus(col, 1);
             }
             '[' => {
-                let mut j = i + 1;
-                loop {
-                    match chars.get(j) {
-                        None | Some('#') => {
-                            diags.push(Diagnostic::new(
-                                DiagnosticCode::UnterminatedBracket,
-                                line,
-                                col_of(i),
-                                "unterminated `[`: no matching `]` on this line",
-                            ));
-                            return None;
-                        }
-                        Some('[') => {
-                            diags.push(Diagnostic::new(
-                                DiagnosticCode::NestedBracket,
-                                line,
-                                col_of(j),
-                                "`[` inside a bracket group: bracket groups do not nest; use \
-                                 parentheses inside brackets",
-                            ));
-                            return None;
-                        }
-                        Some(']') => break,
-                        Some(_) => j += 1,
+                let after = bytes.get(i + 1..).unwrap_or(&[]);
+                let stop = after
+                    .iter()
+                    .position(|b| matches!(b, b'#' | b'[' | b']'))
+                    .map(|k| (i + 1 + k, bytes.get(i + 1 + k).copied()));
+                let inner = |j: usize| text.get(i + 1..j).unwrap_or("");
+                match stop {
+                    Some((j, Some(b']'))) => {
+                        let content = inner(j);
+                        tokens.push(Token {
+                            kind: TokKind::Bracket,
+                            text: content,
+                            col,
+                            inner_col: col_plus(col, 1),
+                        });
+                        col = col_plus(col, width(content).saturating_add(2));
+                        i = j + 1;
+                    }
+                    Some((j, Some(b'['))) => {
+                        diags.push(Diagnostic::new(
+                            DiagnosticCode::NestedBracket,
+                            line,
+                            col_plus(col, width(inner(j)).saturating_add(1)),
+                            "`[` inside a bracket group: bracket groups do not nest; use \
+                             parentheses inside brackets",
+                        ));
+                        return None;
+                    }
+                    _ => {
+                        diags.push(Diagnostic::new(
+                            DiagnosticCode::UnterminatedBracket,
+                            line,
+                            col,
+                            "unterminated `[`: no matching `]` on this line",
+                        ));
+                        return None;
                     }
                 }
-                tokens.push(Token {
-                    kind: TokKind::Bracket,
-                    text: chars.get(i + 1..j).unwrap_or(&[]),
-                    col: col_of(i),
-                    inner_col: col_of(i + 1),
-                });
-                i = j + 1;
             }
             ']' => {
                 diags.push(Diagnostic::new(
                     DiagnosticCode::StrayBracket,
                     line,
-                    col_of(i),
+                    col,
                     "stray `]` without a matching `[`",
                 ));
                 return None;
             }
             '\'' => {
-                let Some(len) = chars
-                    .get(i + 1..)
-                    .and_then(|r| r.iter().position(|&c| c == '\''))
-                else {
+                let after = bytes.get(i + 1..).unwrap_or(&[]);
+                let Some(len) = after.iter().position(|&b| b == b'\'') else {
                     diags.push(Diagnostic::new(
                         DiagnosticCode::UnterminatedQuote,
                         line,
-                        col_of(i),
+                        col,
                         "unterminated quote: no closing `'` on this line",
                     ));
                     return None;
                 };
                 let j = i + 1 + len;
+                let content = text.get(i + 1..j).unwrap_or("");
                 tokens.push(Token {
                     kind: TokKind::Quoted,
-                    text: chars.get(i + 1..j).unwrap_or(&[]),
-                    col: col_of(i),
-                    inner_col: col_of(i + 1),
+                    text: content,
+                    col,
+                    inner_col: col_plus(col, 1),
                 });
+                col = col_plus(col, width(content).saturating_add(2));
                 i = j + 1;
             }
             _ => {
-                let start = i;
-                while let Some(&c) = chars.get(i) {
-                    if is_bare_char(c)
+                let (start, start_col) = (i, col);
+                loop {
+                    let run = bare_ascii_run(bytes.get(i..).unwrap_or(&[]));
+                    i += run;
+                    col = col_plus(col, u32::try_from(run).unwrap_or(u32::MAX));
+                    let Some((c, len)) = char_at(text, i) else {
+                        break;
+                    };
+                    if (!c.is_ascii() && is_bare_char(c))
                         || (c == '+'
-                            && chars.get(i + 1).is_some_and(char::is_ascii_digit)
-                            && ends_with_exponent_marker(chars.get(start..i).unwrap_or(&[])))
+                            && bytes.get(i + 1).is_some_and(u8::is_ascii_digit)
+                            && ends_with_exponent_marker(text.get(start..i).unwrap_or("")))
                     {
                         // `2.5e+3`: the `+` belongs to the number (spec §3.3).
-                        i += 1;
+                        i += len;
+                        col = col_plus(col, 1);
                     } else {
                         break;
                     }
                 }
                 tokens.push(Token {
                     kind: TokKind::Bare,
-                    text: chars.get(start..i).unwrap_or(&[]),
-                    col: col_of(start),
-                    inner_col: col_of(start),
+                    text: text.get(start..i).unwrap_or(""),
+                    col: start_col,
+                    inner_col: start_col,
                 });
             }
         }
@@ -275,21 +323,27 @@ fn lex_line<'a>(
     Some(())
 }
 
+/// An item of a bracket's content: its text and its offset in columns from the content's
+/// first character.
+pub(crate) type BracketItem<'a> = (&'a str, u32);
+
 /// Splits the content of a vector or connection-point bracket into items separated by blanks
-/// outside parentheses (spec §3.3). Returns (start, end) index ranges into `text`.
-pub(crate) fn split_items(text: &[char]) -> Vec<(usize, usize)> {
+/// outside parentheses (spec §3.3).
+pub(crate) fn split_items(text: &str) -> Vec<BracketItem<'_>> {
     let mut items = Vec::new();
     let mut depth: usize = 0;
-    let mut start: Option<usize> = None;
-    for (i, &c) in text.iter().enumerate() {
+    // The item being read: its start (byte, column offset).
+    let mut start: Option<(usize, u32)> = None;
+    for (k, (i, c)) in text.char_indices().enumerate() {
+        let at = u32::try_from(k).unwrap_or(u32::MAX);
         if is_blank(c) && depth == 0 {
-            if let Some(s) = start.take() {
-                items.push((s, i));
+            if let Some((s, sc)) = start.take() {
+                items.push((text.get(s..i).unwrap_or(""), sc));
             }
             continue;
         }
         if start.is_none() {
-            start = Some(i);
+            start = Some((i, at));
         }
         match c {
             '(' => depth += 1,
@@ -297,8 +351,8 @@ pub(crate) fn split_items(text: &[char]) -> Vec<(usize, usize)> {
             _ => {}
         }
     }
-    if let Some(s) = start {
-        items.push((s, text.len()));
+    if let Some((s, sc)) = start {
+        items.push((text.get(s..).unwrap_or(""), sc));
     }
     items
 }
@@ -308,10 +362,9 @@ mod tests {
     use super::*;
 
     fn toks(s: &str) -> Vec<String> {
-        let chars: Vec<char> = s.chars().collect();
         let mut d = Diags::default();
         let mut tokens = Vec::new();
-        tokenize(&chars, 1, &mut d, &mut tokens).unwrap();
+        tokenize(s, 1, &mut d, &mut tokens).unwrap();
         tokens.iter().map(Token::source).collect()
     }
 
@@ -338,7 +391,10 @@ mod tests {
 
     #[test]
     fn items_split_outside_parens() {
-        let t: Vec<char> = "@s (a + b)  c".chars().collect();
-        assert_eq!(split_items(&t), vec![(0, 2), (3, 10), (12, 13)]);
+        assert_eq!(
+            split_items("@s (a + b)  c"),
+            vec![("@s", 0), ("(a + b)", 3), ("c", 12)]
+        );
+        assert_eq!(split_items("é\t(ü b) c"), vec![("é", 0), ("(ü b)", 2), ("c", 8)]);
     }
 }

@@ -3,11 +3,11 @@
 use super::diagnostics::DiagnosticCode;
 use super::lexer::{TokKind, Token};
 
-/// Scans the number grammar of spec §3.5 from `start`. Returns the end index, or `None` when no
-/// number starts there.
-pub(crate) fn scan_number(chars: &[char], start: usize) -> Option<usize> {
+/// Scans the number grammar of spec §3.5 from byte `start` of `text` (a number is ASCII, so
+/// bytes are characters). Returns the end index, or `None` when no number starts there.
+pub(crate) fn scan_number(text: &[u8], start: usize) -> Option<usize> {
     let digits = |mut j: usize| {
-        while chars.get(j).is_some_and(char::is_ascii_digit) {
+        while text.get(j).is_some_and(u8::is_ascii_digit) {
             j += 1;
         }
         j
@@ -15,7 +15,7 @@ pub(crate) fn scan_number(chars: &[char], start: usize) -> Option<usize> {
     let mut j = digits(start);
     let int_digits = j - start;
     let mut frac_digits = 0;
-    if chars.get(j) == Some(&'.') {
+    if text.get(j) == Some(&b'.') {
         let k = digits(j + 1);
         frac_digits = k - (j + 1);
         j = k;
@@ -23,12 +23,12 @@ pub(crate) fn scan_number(chars: &[char], start: usize) -> Option<usize> {
     if int_digits == 0 && frac_digits == 0 {
         return None;
     }
-    if matches!(chars.get(j), Some('e' | 'E')) {
+    if matches!(text.get(j), Some(b'e' | b'E')) {
         let mut k = j + 1;
-        if matches!(chars.get(k), Some('+' | '-')) {
+        if matches!(text.get(k), Some(b'+' | b'-')) {
             k += 1;
         }
-        if chars.get(k).is_some_and(char::is_ascii_digit) {
+        if text.get(k).is_some_and(u8::is_ascii_digit) {
             j = digits(k);
         }
     }
@@ -61,23 +61,12 @@ pub(crate) fn token_number_literal(t: &Token) -> Result<f64, NumberError> {
     }
 }
 
-pub(crate) fn to_f64(chars: &[char]) -> Result<f64, NumberError> {
-    if let Some(v) = exact_decimal(chars) {
+/// The value of a literal that [`scan_number`] accepted, correctly rounded.
+pub(crate) fn to_f64(text: &str) -> Result<f64, NumberError> {
+    if let Some(v) = exact_decimal(text.as_bytes()) {
         return Ok(v);
     }
-    // Literals are ASCII and short: read them from the stack, not from a fresh String.
-    let mut buf = [0u8; 64];
-    let parsed = if chars.len() <= buf.len() && chars.iter().all(char::is_ascii) {
-        for (b, c) in buf.iter_mut().zip(chars) {
-            *b = *c as u8;
-        }
-        std::str::from_utf8(&buf[..chars.len()])
-            .map_err(|_| NumberError::Invalid)?
-            .parse::<f64>()
-    } else {
-        chars.iter().collect::<String>().parse::<f64>()
-    };
-    match parsed {
+    match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(NumberError::NonFinite),
         Err(_) => Err(NumberError::Invalid),
@@ -94,22 +83,20 @@ const EXACT_POWERS_OF_TEN: [f64; 23] = [
 /// most 2^53, with at most 22 after the point: m and 10^f are then exact in f64, and one
 /// correctly rounded division gives the correctly rounded value, the same as `str::parse`
 /// (Clinger's fast path, which the standard library takes too). `None` for anything else.
-fn exact_decimal(chars: &[char]) -> Option<f64> {
+fn exact_decimal(text: &[u8]) -> Option<f64> {
     let mut m: u64 = 0;
     let mut digits = 0usize;
     let mut frac: Option<usize> = None;
-    for &c in chars {
+    for &c in text {
         match c {
-            '0'..='9' => {
-                m = m
-                    .checked_mul(10)?
-                    .checked_add(u64::from(c) - u64::from('0'))?;
+            b'0'..=b'9' => {
+                m = m.checked_mul(10)?.checked_add(u64::from(c - b'0'))?;
                 digits += 1;
                 if let Some(f) = frac.as_mut() {
                     *f += 1;
                 }
             }
-            '.' if frac.is_none() => frac = Some(0),
+            b'.' if frac.is_none() => frac = Some(0),
             _ => return None,
         }
     }
@@ -120,15 +107,20 @@ fn exact_decimal(chars: &[char]) -> Option<f64> {
     Some(m as f64 / power)
 }
 
+/// A leading `-` (true) or `+` taken off `text`.
+fn split_sign(text: &str) -> (bool, &str) {
+    match text.as_bytes().first() {
+        Some(b'-') => (true, text.get(1..).unwrap_or("")),
+        Some(b'+') => (false, text.get(1..).unwrap_or("")),
+        _ => (false, text),
+    }
+}
+
 /// A numeric literal with an optional sign, the only form allowed for `param` values and legacy
 /// tag coordinates (spec §3.5, §3.8, §6.4).
-pub(crate) fn parse_number_literal(chars: &[char]) -> Result<f64, NumberError> {
-    let (negative, body) = match chars.split_first() {
-        Some(('-', rest)) => (true, rest),
-        Some(('+', rest)) => (false, rest),
-        _ => (false, chars),
-    };
-    match scan_number(body, 0) {
+pub(crate) fn parse_number_literal(text: &str) -> Result<f64, NumberError> {
+    let (negative, body) = split_sign(text);
+    match scan_number(body.as_bytes(), 0) {
         Some(end) if end == body.len() => to_f64(body).map(|v| if negative { -v } else { v }),
         _ => Err(NumberError::Invalid),
     }
@@ -138,13 +130,9 @@ pub(crate) fn parse_number_literal(chars: &[char]) -> Result<f64, NumberError> {
 /// argument, read without the tokens and tree of the general parser. Gives what the parser
 /// gives (a sign before a literal folds into it, unary plus is dropped), and `None` for
 /// anything else, a non-finite literal included, which the parser then reads and reports.
-pub(crate) fn plain_number(chars: &[char]) -> Option<f64> {
-    let (negative, body) = match chars.split_first()? {
-        ('-', rest) => (true, rest),
-        ('+', rest) => (false, rest),
-        _ => (false, chars),
-    };
-    if scan_number(body, 0)? != body.len() {
+pub(crate) fn plain_number(text: &str) -> Option<f64> {
+    let (negative, body) = split_sign(text);
+    if scan_number(body.as_bytes(), 0)? != body.len() {
         return None;
     }
     let v = to_f64(body).ok()?;
@@ -158,8 +146,7 @@ mod tests {
     #[test]
     fn exact_decimals_read_as_the_standard_parser_reads_them() {
         let check = |text: &str| {
-            let chars: Vec<char> = text.chars().collect();
-            if let Some(v) = exact_decimal(&chars) {
+            if let Some(v) = exact_decimal(text.as_bytes()) {
                 let expected: f64 = text.parse().unwrap();
                 assert_eq!(v.to_bits(), expected.to_bits(), "{text}");
             }
@@ -183,8 +170,8 @@ mod tests {
         ] {
             check(text);
         }
-        assert_eq!(exact_decimal(&['.']), None);
-        assert_eq!(exact_decimal(&['1', 'e', '3']), None);
+        assert_eq!(exact_decimal(b"."), None);
+        assert_eq!(exact_decimal(b"1e3"), None);
         // Every length and point position, with digits from a fixed pseudo-random sequence.
         let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
         for len in 1..=24 {
@@ -208,7 +195,7 @@ mod tests {
 
     #[test]
     fn literals() {
-        let l = |s: &str| parse_number_literal(&s.chars().collect::<Vec<_>>());
+        let l = parse_number_literal;
         assert_eq!(l("-0.2"), Ok(-0.2));
         assert_eq!(l("+3"), Ok(3.0));
         assert_eq!(l("1e999"), Err(NumberError::NonFinite));

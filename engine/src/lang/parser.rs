@@ -130,20 +130,8 @@ impl Position {
 }
 
 fn parse_with(text: &str, mut diags: Diags) -> Parsed {
-    // Every line's characters in one buffer, which the tokens borrow.
-    let mut buffer: Vec<char> = Vec::with_capacity(text.len());
-    let mut lines = Vec::new();
-    for (line, s) in split_lines(text) {
-        let start = buffer.len();
-        if s.is_ascii() {
-            // Most scripts: one char per byte, an exact-size copy.
-            buffer.extend(s.bytes().map(char::from));
-        } else {
-            buffer.extend(s.chars());
-        }
-        lines.push((line, start..buffer.len()));
-    }
-    let (mut items, tokens) = lines::read_items(&buffer, lines, &mut diags);
+    // The tokens borrow the script's text.
+    let (mut items, tokens) = lines::read_items(split_lines(text), &mut diags);
     let symbols = labels::declare_labels(&mut items, &tokens, &mut diags);
 
     // Pass 2: directives and commands in script order.

@@ -4,21 +4,14 @@
 
 use super::*;
 
-fn col_plus(col: u32, i: usize) -> u32 {
-    col.saturating_add(u32::try_from(i).unwrap_or(u32::MAX))
-}
-
-/// Splits `chars` at `sep`, returning each piece with its column.
-fn split(chars: &[char], col: u32, sep: char) -> Vec<(&[char], u32)> {
+/// Splits `text` at `sep`, returning each piece with its column.
+fn split(text: &str, col: u32, sep: char) -> Vec<(&str, u32)> {
     let mut out = Vec::new();
-    let mut start = 0;
-    for (i, &c) in chars.iter().enumerate() {
-        if c == sep {
-            out.push((chars.get(start..i).unwrap_or(&[]), col_plus(col, start)));
-            start = i + 1;
-        }
+    let mut piece_col = col;
+    for piece in text.split(sep) {
+        out.push((piece, piece_col));
+        piece_col = col_plus(piece_col, width(piece).saturating_add(1));
     }
-    out.push((chars.get(start..).unwrap_or(&[]), col_plus(col, start)));
     out
 }
 
@@ -117,7 +110,7 @@ pub(crate) fn read(tokens: &[Token], line: u32, diags: &mut Diags, budget: &mut 
     while let Some(t) = rest.get(i) {
         i += 1;
         let text = t.string();
-        let eq = t.text.iter().position(|&c| c == '=');
+        let eq = t.text.find('=');
         let (Some(eq), TokKind::Bare) = (eq, t.kind) else {
             push(
                 diags,
@@ -133,21 +126,21 @@ pub(crate) fn read(tokens: &[Token], line: u32, diags: &mut Diags, budget: &mut 
             ok = false;
             continue;
         };
-        let key_text: String = t.text.get(..eq).unwrap_or(&[]).iter().collect();
+        let key_text = t.text.get(..eq).unwrap_or("").to_string();
         let mut value = Val {
-            chars: t.text.get(eq + 1..).unwrap_or(&[]).to_vec(),
-            col: col_plus(t.col, eq + 1),
+            value: t.text.get(eq + 1..).unwrap_or("").to_string(),
+            col: col_plus(t.col, width(&key_text).saturating_add(1)),
             bracket: false,
         };
-        if value.chars.is_empty() {
+        if value.value.is_empty() {
             // `key=[ … ]` or `key='…'`: the group written right after the `=`.
-            let end_col = col_plus(t.col, t.text.len());
+            let end_col = col_plus(t.col, width(t.text));
             if let Some(g) = rest
                 .get(i)
                 .filter(|g| g.kind != TokKind::Bare && g.col == end_col)
             {
                 value = Val {
-                    chars: g.text.to_vec(),
+                    value: g.string(),
                     col: g.inner_col,
                     bracket: g.kind == TokKind::Bracket,
                 };
@@ -220,7 +213,7 @@ pub(crate) fn read(tokens: &[Token], line: u32, diags: &mut Diags, budget: &mut 
             continue;
         }
         given.push((key, t.col));
-        if value.chars.iter().all(|c| is_blank(*c)) {
+        if value.value.chars().all(is_blank) {
             push(
                 diags,
                 diag(
@@ -475,7 +468,7 @@ impl Reader<'_> {
 
     /// `n` comma-separated integer literals (`40` or `40.`), each at least the kind's minimum.
     fn integers(&mut self, key: Key, v: &Val, n: usize) -> Option<Vec<usize>> {
-        let parts = split(&v.chars, v.col, ',');
+        let parts = split(&v.value, v.col, ',');
         if parts.len() != n || v.bracket {
             let found = if v.bracket {
                 format!("[{}]", v.text())
@@ -497,8 +490,8 @@ impl Reader<'_> {
         }
         let min = minimum(self.kind);
         let mut out = Vec::with_capacity(n);
-        for (chars, col) in parts {
-            let text: String = chars.iter().collect();
+        for (text, col) in parts {
+            let text = text.to_string();
             let (int_part, frac) = text.split_once('.').unwrap_or((text.as_str(), ""));
             let is_integer = !int_part.is_empty()
                 && int_part.chars().all(|c| c.is_ascii_digit())
@@ -547,10 +540,8 @@ impl Reader<'_> {
     }
 
     /// A finite numeric literal.
-    fn literal(&mut self, key: Key, chars: &[char], col: u32) -> Option<f64> {
-        let text: String = chars.iter().collect();
-        let trimmed: Vec<char> = text.trim().chars().collect();
-        match parse_number_literal(&trimmed) {
+    fn literal(&mut self, key: Key, text: &str, col: u32) -> Option<f64> {
+        match parse_number_literal(text.trim()) {
             Ok(v) => Some(v),
             Err(e) => {
                 let (code, message) = match e {
@@ -573,18 +564,18 @@ impl Reader<'_> {
     }
 
     fn number(&mut self, key: Key, v: &Val) -> Option<f64> {
-        self.literal(key, &v.chars, v.col)
+        self.literal(key, &v.value, v.col)
     }
 
     /// `x,y,z`, or `[x y z]` as positions are written elsewhere (spec §3.7).
     fn triple(&mut self, key: Key, v: &Val) -> Option<[f64; 3]> {
-        let parts: Vec<(&[char], u32)> = if v.bracket {
-            split_items(&v.chars)
+        let parts: Vec<(&str, u32)> = if v.bracket {
+            split_items(&v.value)
                 .into_iter()
-                .map(|(s, e)| (v.chars.get(s..e).unwrap_or(&[]), col_plus(v.col, s)))
+                .map(|(item, offset)| (item, col_plus(v.col, offset)))
                 .collect()
         } else {
-            split(&v.chars, v.col, ',')
+            split(&v.value, v.col, ',')
         };
         if parts.len() != 3 {
             let found = v.text();
@@ -603,8 +594,8 @@ impl Reader<'_> {
         }
         let mut out = [0.0; 3];
         let mut good = true;
-        for (slot, (chars, col)) in out.iter_mut().zip(parts) {
-            match self.literal(key, chars, col) {
+        for (slot, (text, col)) in out.iter_mut().zip(parts) {
+            match self.literal(key, text, col) {
                 Some(x) => *slot = x,
                 None => good = false,
             }
@@ -671,10 +662,10 @@ impl Reader<'_> {
     fn points(&mut self, v: &Val) -> Option<Vec<(f64, f64)>> {
         let mut out = Vec::new();
         let mut good = true;
-        for (chars, col) in split(&v.chars, v.col, ';') {
-            let pair = split(chars, col, ',');
+        for (point, col) in split(&v.value, v.col, ';') {
+            let pair = split(point, col, ',');
             let [(x, xc), (y, yc)] = pair.as_slice() else {
-                let found: String = chars.iter().collect();
+                let found = point.to_string();
                 self.bad(
                     DiagnosticCode::InvalidGeneratorValue,
                     col,

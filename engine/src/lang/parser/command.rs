@@ -2,7 +2,7 @@
 //! (spec §6.4) and the legacy proxy forms (spec §3.14), then the element or parameter it
 //! declares, in the open buffer scopes.
 
-use super::keywords::{arity, shape_of_chars, Shape, KEYWORDS};
+use super::keywords::{arity, shape_of, Shape, KEYWORDS};
 use super::lines::Item;
 use super::{At, Builder};
 use crate::lang::diagnostics::DiagnosticCode;
@@ -49,7 +49,7 @@ impl Builder<'_> {
         let shape = if kw.kind == TokKind::Bracket {
             None
         } else {
-            shape_of_chars(kw.text)
+            shape_of(kw.text)
         };
         let Some(shape) = shape else {
             let keyword = kw.string();
@@ -121,7 +121,7 @@ impl Builder<'_> {
             tag_xy = Some((tag.x, tag.y));
         }
         self.spec.elements.push(Element {
-            label,
+            label: label.to_string(),
             kind,
             buffers,
             tag_xy,
@@ -219,9 +219,9 @@ impl Builder<'_> {
             };
             let names_macro = args.iter().take(slots).any(|t| {
                 t.kind == TokKind::Bare
-                    && t.text.first() == Some(&'@')
+                    && t.starts_with_at()
                     && matches!(
-                        self.symbols.get(&t.label()),
+                        self.symbols.get(t.label()),
                         Some(Symbol {
                             kind: SymKind::Macro { .. },
                             ..

@@ -35,13 +35,13 @@ impl Builder<'_> {
             label: None,
         };
         if matches!(
-            name.as_str(),
+            name,
             "pitch" | "key" | "note" | "route" | "macro" | "voices" | "pressure"
         ) {
-            self.host_directive(item, &name, first.col, args);
+            self.host_directive(item, name, first.col, args);
             return;
         }
-        let expected = match name.as_str() {
+        let expected = match name {
             "begin" | "end" => "a buffer name (an identifier)",
             "samplerate" => "`raw` or `scaled`",
             _ => {

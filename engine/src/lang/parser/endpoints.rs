@@ -5,7 +5,7 @@ use super::{At, Builder};
 use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::legacy;
-use crate::lang::lexer::{is_blank, split_items, text_of, TokKind, Token};
+use crate::lang::lexer::{after_first, col_plus, split_items, TokKind, Token};
 use crate::lang::symbols::SymKind;
 use crate::spec::Endpoint;
 
@@ -14,7 +14,7 @@ impl Builder<'_> {
     /// `[@mesh u w]`.
     fn endpoint(&mut self, t: &Token, at: At<'_>) -> Option<Endpoint> {
         match t.kind {
-            TokKind::Bare if t.text.first() == Some(&'@') => {
+            TokKind::Bare if t.starts_with_at() => {
                 let name = t.label();
                 if name.is_empty() {
                     self.diags.push(at.diag(
@@ -24,7 +24,7 @@ impl Builder<'_> {
                     ));
                     return None;
                 }
-                let ok = match self.symbols.get(&name).map(|s| s.kind) {
+                let ok = match self.symbols.get(name).map(|s| s.kind) {
                     Some(SymKind::Point | SymKind::Unknown) => true,
                     None => {
                         self.diags.push(
@@ -70,9 +70,9 @@ impl Builder<'_> {
                         false
                     }
                 };
-                ok.then_some(Endpoint::Label(name))
+                ok.then(|| Endpoint::Label(name.to_string()))
             }
-            TokKind::Bracket if t.text.iter().find(|c| !is_blank(**c)) == Some(&'@') => {
+            TokKind::Bracket if t.first_non_blank() == Some('@') => {
                 self.connection_point(t, at)
             }
             _ => {
@@ -120,11 +120,9 @@ impl Builder<'_> {
 
     fn connection_point(&mut self, t: &Token, at: At<'_>) -> Option<Endpoint> {
         let items = split_items(t.text);
-        let &(s, e) = items.first()?;
-        let target = text_of(t.text.get(s + 1..e).unwrap_or(&[]));
-        let target_col = t
-            .inner_col
-            .saturating_add(u32::try_from(s).unwrap_or(u32::MAX));
+        let &(first, offset) = items.first()?;
+        let target = after_first(first).to_string();
+        let target_col = col_plus(t.inner_col, offset);
         if target.is_empty() || target.contains(['(', ')']) {
             self.diags.push(
                 at.diag(
@@ -215,7 +213,7 @@ impl Builder<'_> {
         }
         let exprs: Vec<Option<Expr>> = coords
             .iter()
-            .map(|&range| self.item_expr(t, range, at))
+            .map(|&item| self.item_expr(t, item, at))
             .collect();
         let exprs: Option<Vec<Expr>> = exprs.into_iter().collect();
         let exprs = exprs?;

@@ -74,14 +74,6 @@ pub(super) fn shape_of(keyword: &str) -> Option<Shape> {
         .map(|(_, s)| *s)
 }
 
-/// [`shape_of`] a token's text, without making a string of it.
-pub(super) fn shape_of_chars(keyword: &[char]) -> Option<Shape> {
-    KEYWORDS
-        .iter()
-        .find(|(k, _)| k.len() == keyword.len() && k.chars().eq(keyword.iter().copied()))
-        .map(|(_, s)| *s)
-}
-
 /// The accepted argument counts (after the keyword) and the signature for messages (§2.9).
 pub(super) fn arity(shape: Shape) -> (usize, usize, &'static str) {
     use LawKind as L;

@@ -1,6 +1,6 @@
 //! Pass 1: the labels of a script.
 
-use super::keywords::{shape_of_chars, sym_kind};
+use super::keywords::{shape_of, sym_kind};
 use super::lines::{is_generate, Item};
 use crate::lang::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use crate::lang::generate::{self, GenRequest, Read, MAX_GENERATED_ELEMENTS};
@@ -50,7 +50,7 @@ pub(super) fn declare_labels(items: &mut [Item], all: &[Token], diags: &mut Diag
         let kind = tokens
             .get(1)
             .filter(|t| t.kind != TokKind::Bracket)
-            .and_then(|t| shape_of_chars(t.text))
+            .and_then(|t| shape_of(t.text))
             .map(sym_kind)
             .unwrap_or(SymKind::Unknown);
         let symbol = Symbol {
@@ -59,7 +59,7 @@ pub(super) fn declare_labels(items: &mut [Item], all: &[Token], diags: &mut Diag
             col: first.col,
             generated: false,
         };
-        if let Err((label, prev)) = symbols.declare(label, symbol) {
+        if let Err((label, prev)) = symbols.declare(label.to_string(), symbol) {
             let message = if prev.generated {
                 format!(
                     "duplicate label `@{label}`: the `~generate` at line {} column {} \

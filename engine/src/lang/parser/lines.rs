@@ -3,29 +3,27 @@
 use super::keywords::shape_of;
 use crate::lang::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use crate::lang::generate::{self, GenRequest};
-use crate::lang::lexer::{is_blank, tokenize, TokKind, Token};
+use crate::lang::lexer::{is_blank, tokenize, width, TokKind, Token};
 
-/// Reads the script's lines (`(line number, range in buffer)`) into items: command and
+/// Reads the script's lines (`(line number, text)`) into items: command and
 /// directive lines tokenised, comments and blank lines skipped, other lines ignored with a
 /// warning when they look like a command. The tokens of every item are in one vector (one
 /// allocation for the script, not one per line).
 pub(super) fn read_items<'a>(
-    buffer: &'a [char],
-    lines: Vec<(u32, std::ops::Range<usize>)>,
+    lines: Vec<(u32, &'a str)>,
     diags: &mut Diags,
 ) -> (Vec<Item>, Vec<Token<'a>>) {
     let mut items = Vec::with_capacity(lines.len());
     // A command has a label, a keyword and a few arguments.
     let mut tokens = Vec::with_capacity(lines.len() * 6);
-    for (line, range) in lines {
-        let chars = buffer.get(range).unwrap_or(&[]);
-        let Some(first) = chars.iter().position(|c| !is_blank(*c)) else {
+    for (line, text) in lines {
+        let Some((first, lead)) = text.char_indices().find(|(_, c)| !is_blank(*c)) else {
             continue;
         };
-        match chars.get(first) {
-            Some('@') | Some('~') => {
-                let directive = chars.get(first) == Some(&'~');
-                match tokenize(chars, line, diags, &mut tokens) {
+        match lead {
+            '@' | '~' => {
+                let directive = lead == '~';
+                match tokenize(text, line, diags, &mut tokens) {
                     Some(range) => items.push(Item {
                         line,
                         directive,
@@ -37,19 +35,19 @@ pub(super) fn read_items<'a>(
                     None if !directive => {
                         // Keep the label known so references to it do not cascade: the line
                         // takes part in pass 1 with its label only (kind unknown).
-                        let rest = chars.get(first..).unwrap_or(&[]);
+                        let rest = text.get(first..).unwrap_or("");
                         let len = rest
-                            .iter()
-                            .take_while(|c| {
-                                !is_blank(**c) && !matches!(c, '+' | '[' | ']' | '\'' | '#')
+                            .find(|c: char| {
+                                is_blank(c) || matches!(c, '+' | '[' | ']' | '\'' | '#')
                             })
-                            .count();
-                        let label = rest.get(..len).unwrap_or(&[]);
+                            .unwrap_or(rest.len());
+                        let label = rest.get(..len).unwrap_or("");
+                        let col = col_of(text.get(..first).unwrap_or(""));
                         tokens.push(Token {
                             kind: TokKind::Bare,
                             text: label,
-                            col: col_of(first),
-                            inner_col: col_of(first),
+                            col,
+                            inner_col: col,
                         });
                         items.push(Item {
                             line,
@@ -63,8 +61,9 @@ pub(super) fn read_items<'a>(
                     None => {
                         // A `~generate` line with a lexical error: its labels are unknown, so
                         // references to them must not cascade.
-                        let text: String = chars.iter().skip(first).collect();
                         let words: Vec<&str> = text
+                            .get(first..)
+                            .unwrap_or("")
                             .split(is_blank)
                             .filter(|w| !w.is_empty())
                             .take(3)
@@ -82,36 +81,38 @@ pub(super) fn read_items<'a>(
                     }
                 }
             }
-            Some('#') => {}
-            _ => check_ignored_line(chars, line, diags),
+            '#' => {}
+            _ => check_ignored_line(text, line, diags),
         }
     }
     (items, tokens)
 }
 
-fn col_of(i: usize) -> u32 {
-    u32::try_from(i.saturating_add(1)).unwrap_or(u32::MAX)
+/// The column of the character after `before`.
+fn col_of(before: &str) -> u32 {
+    width(before).saturating_add(1)
 }
 
 /// Warns when an ignored line looks like a command with a forgotten `@` (spec §3.2): its first
 /// word is a type keyword (`mass 1 0 0`), or its second word is one after a label-like first
 /// word (`m mass 1 0 0`).
-fn check_ignored_line(chars: &[char], line: u32, diags: &mut Diags) {
-    let mut words: Vec<(usize, String)> = Vec::new();
-    let mut i = 0;
+fn check_ignored_line(text: &str, line: u32, diags: &mut Diags) {
+    // The first two words, each with its column.
+    let mut words: Vec<(u32, String)> = Vec::new();
+    let mut rest = text;
     while words.len() < 2 {
-        while chars.get(i).is_some_and(|c| is_blank(*c)) {
-            i += 1;
-        }
-        let start = i;
-        while chars.get(i).is_some_and(|c| !is_blank(*c) && *c != '#') {
-            i += 1;
-        }
-        if i == start {
+        let word_at = rest.find(|c: char| !is_blank(c)).unwrap_or(rest.len());
+        let word = rest.get(word_at..).unwrap_or("");
+        let len = word
+            .find(|c: char| is_blank(c) || c == '#')
+            .unwrap_or(word.len());
+        if len == 0 {
             break;
         }
-        words.push((start, chars.get(start..i).unwrap_or(&[]).iter().collect()));
-        if chars.get(i) == Some(&'#') {
+        let before = text.len() - rest.len() + word_at;
+        words.push((col_of(text.get(..before).unwrap_or("")), word.get(..len).unwrap_or("").to_string()));
+        rest = word.get(len..).unwrap_or("");
+        if rest.starts_with('#') {
             break;
         }
     }
@@ -124,7 +125,7 @@ fn check_ignored_line(chars: &[char], line: u32, diags: &mut Diags) {
         }
         _ => None,
     };
-    if let Some((c, keyword, has_label)) = hit {
+    if let Some((col, keyword, has_label)) = hit {
         let message = if has_label {
             format!("line ignored: it looks like a `{keyword}` command whose label lacks `@`")
         } else {
@@ -134,7 +135,7 @@ fn check_ignored_line(chars: &[char], line: u32, diags: &mut Diags) {
             )
         };
         diags.push(
-            Diagnostic::new(DiagnosticCode::IgnoredCommandLike, line, col_of(c), message)
+            Diagnostic::new(DiagnosticCode::IgnoredCommandLike, line, col, message)
                 .with_expected("@label keyword arguments…"),
         );
     }
@@ -166,7 +167,5 @@ pub(super) fn is_generate(item: &Item, all: &[Token]) -> bool {
         && item
             .tokens(all)
             .first()
-            .is_some_and(|t| *t.text == GENERATE)
+            .is_some_and(|t| t.text == "~generate")
 }
-
-pub(super) const GENERATE: [char; 9] = ['~', 'g', 'e', 'n', 'e', 'r', 'a', 't', 'e'];

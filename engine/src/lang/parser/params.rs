@@ -54,11 +54,11 @@ impl Builder<'_> {
     /// one written first (`audioParam 0.3 @in3`) is reported with the right order.
     fn audio_param(&mut self, args: &[Token], at: At<'_>) -> Option<ParamKind> {
         let v = &args[0];
-        let is_label = v.kind == TokKind::Bare && v.text.first() == Some(&'@');
+        let is_label = v.kind == TokKind::Bare && v.starts_with_at();
         if !is_label {
             let swapped = args.len() == 2
                 && args[1].kind == TokKind::Bare
-                && args[1].text.first() == Some(&'@')
+                && args[1].starts_with_at()
                 && parse_number_literal(v.text).is_ok();
             let message = if swapped {
                 format!(
@@ -79,8 +79,7 @@ impl Builder<'_> {
             );
             return None;
         }
-        let label: String = v.text[1..].iter().collect();
-        let input = self.channel(&label, "in", v, at);
+        let input = self.channel(v.label(), "in", v, at);
         let default = match args.get(1) {
             Some(d) => Some(self.literal(d, "an audioParam default", at)?),
             None => Some(0.0),

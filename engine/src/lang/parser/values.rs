@@ -5,14 +5,13 @@ use super::{At, Builder, MAX_MACRO_NODES};
 use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::expr_parser::{parse_expression, ExprContext};
-use crate::lang::lexer::{is_blank, split_items, TokKind, Token};
+use crate::lang::lexer::{col_plus, is_blank, split_items, BracketItem, TokKind, Token};
 use crate::lang::symbols::SymKind;
 use crate::spec::Vector;
 
 impl Builder<'_> {
     pub(super) fn expr(&mut self, t: &Token, at: At<'_>) -> Option<Expr> {
-        let trimmed_first = t.text.iter().find(|c| !is_blank(**c));
-        if t.kind == TokKind::Bracket && trimmed_first == Some(&'@') {
+        if t.kind == TokKind::Bracket && t.first_non_blank() == Some('@') {
             self.diags.push(
                 at.diag(
                     DiagnosticCode::ExpressionSyntax,
@@ -24,7 +23,7 @@ impl Builder<'_> {
             );
             return None;
         }
-        if t.kind == TokKind::Bare && t.text.first() == Some(&'@') {
+        if t.kind == TokKind::Bare && t.starts_with_at() {
             self.diags.push(
                 at.diag(
                     DiagnosticCode::ExpressionSyntax,
@@ -40,7 +39,7 @@ impl Builder<'_> {
             );
             return None;
         }
-        if t.text.iter().all(|c| is_blank(*c)) {
+        if t.text.chars().all(is_blank) {
             self.diags.push(
                 at.diag(DiagnosticCode::ExpressionSyntax, t.col, "empty expression")
                     .with_found(t.source()),
@@ -59,25 +58,21 @@ impl Builder<'_> {
     pub(super) fn item_expr(
         &mut self,
         t: &Token,
-        (s, e): (usize, usize),
+        (text, offset): BracketItem<'_>,
         at: At<'_>,
     ) -> Option<Expr> {
-        let chars = t.text.get(s..e).unwrap_or(&[]);
         let cx = ExprContext {
             symbols: self.symbols,
             line: at.line,
             label: at.label,
         };
-        let col = t
-            .inner_col
-            .saturating_add(u32::try_from(s).unwrap_or(u32::MAX));
-        parse_expression(chars, col, &cx, &mut self.diags)
+        parse_expression(text, col_plus(t.inner_col, offset), &cx, &mut self.diags)
     }
 
     /// A position or velocity (spec §3.7): a scalar z, or a bracket `[x y z]` whose items are
     /// space-free tokens or parenthesised expressions. A one-item bracket is a scalar.
     pub(super) fn vector(&mut self, t: &Token, at: At<'_>) -> Option<Vector> {
-        if t.kind != TokKind::Bracket || t.text.iter().find(|c| !is_blank(**c)) == Some(&'@') {
+        if t.kind != TokKind::Bracket || t.first_non_blank() == Some('@') {
             return self.expr(t, at).map(Vector::Scalar);
         }
         let items = split_items(t.text);
