@@ -437,8 +437,14 @@ impl Program {
     /// and never grows past its capacity, so this does not allocate.
     #[inline]
     pub(crate) fn eval(&self, e: ExprRef, params: &[f64], stack: &mut Vec<f64>) -> f64 {
-        stack.clear();
         let ops = &self.ops[e.start as usize..(e.start + e.len) as usize];
+        // Most arguments are one literal or one parameter: no stack needed.
+        match ops {
+            [Op::Const(v)] => return *v,
+            [Op::Param(i)] => return params.get(*i as usize).copied().unwrap_or(f64::NAN),
+            _ => {}
+        }
+        stack.clear();
         for op in ops {
             match *op {
                 Op::Const(v) => stack.push(v),

@@ -32,7 +32,7 @@ pub struct PointInfo {
 /// An element that owns points: a single mass-type element, a macro or an avatar.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OwnerInfo {
-    pub label: String,
+    pub label: crate::spec::Label,
     pub keyword: &'static str,
     /// For meshes, the width W (nodes are i·W + j); 0 for everything else.
     pub mesh_width: u32,
@@ -119,7 +119,7 @@ impl ModelInfo {
                 p.node % owner.mesh_width
             ),
             PointKind::MacroNode { .. } => format!("{}[{}]", owner.label, p.node),
-            _ => owner.label.clone(),
+            _ => owner.label.to_string(),
         }
     }
 }

@@ -13,6 +13,11 @@ mod host;
 pub use builder::ModelBuilder;
 pub use host::{HostSpec, MacroRange, Route, RouteSource};
 
+/// An element's label or the label an endpoint names, without `@`. Labels up to 23 bytes (nearly
+/// all) are stored inline, so a spec of thousands of elements holds no string per label, and a
+/// clone copies. Compares with, hashes as and dereferences to its `str`.
+pub type Label = smol_str::SmolStr;
+
 /// Where a construct stood in its script: 1-based line and column (Unicode scalar values, a
 /// tab counting as one). `0:0` means "not from a script" (built in Rust).
 ///
@@ -120,23 +125,23 @@ impl From<[f64; 3]> for Vector {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Endpoint {
     /// `@label`: a mass-type element or an avatar (and, for outputs, a ground).
-    Label(String),
+    Label(Label),
     /// `[@macro α]` on a string, chain or stiff string: α ∈ [0, 1] along the nodes.
-    Line { target: String, alpha: Expr },
+    Line { target: Label, alpha: Expr },
     /// `[@mesh u w]` on a mesh: u along the length, w along the width.
-    Surface { target: String, u: Expr, w: Expr },
+    Surface { target: Label, u: Expr, w: Expr },
 }
 
 impl Endpoint {
     /// `@label`.
     pub fn label(label: &str) -> Endpoint {
-        Endpoint::Label(label.to_string())
+        Endpoint::Label(label.into())
     }
 
     /// `[@target alpha]`.
     pub fn at(target: &str, alpha: impl Into<Expr>) -> Endpoint {
         Endpoint::Line {
-            target: target.to_string(),
+            target: target.into(),
             alpha: alpha.into(),
         }
     }
@@ -144,7 +149,7 @@ impl Endpoint {
     /// `[@target u w]`.
     pub fn at2(target: &str, u: impl Into<Expr>, w: impl Into<Expr>) -> Endpoint {
         Endpoint::Surface {
-            target: target.to_string(),
+            target: target.into(),
             u: u.into(),
             w: w.into(),
         }
@@ -422,7 +427,7 @@ impl ElementKind {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Element {
     /// The label without `@` (`in3`, `out1` for inputs and outputs).
-    pub label: String,
+    pub label: Label,
     pub kind: ElementKind,
     /// The named motion buffers (indices into [`ModelSpec::buffers`]) the element's points
     /// belong to: the scopes open at its line, and a legacy tag.

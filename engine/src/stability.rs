@@ -263,7 +263,7 @@ fn analyze(e: &Engine) -> StabilityReport {
         if !(load < 1.0) {
             let owner = &info.owners[info.points[base].owner as usize];
             warnings.push(StabilityWarning::StructureLimit {
-                label: owner.label.clone(),
+                label: owner.label.to_string(),
                 keyword: owner.keyword,
                 load,
             });

@@ -68,7 +68,7 @@ impl Graph {
                 _ => continue,
             };
             index.insert(e.label.clone(), g.nodes.len());
-            g.nodes.push(e.label.clone());
+            g.nodes.push(e.label.to_string());
             g.fixed.push(fixed);
             g.pos.push(xyz(pos));
         }

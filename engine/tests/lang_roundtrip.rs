@@ -129,16 +129,23 @@ fn endpoint(
     points: Vec<String>,
     macros: Vec<(String, bool)>,
 ) -> BoxedStrategy<Endpoint> {
-    let label = select(points).prop_map(Endpoint::Label);
+    let label = select(points).prop_map(|l| Endpoint::Label(l.into()));
     if macros.is_empty() {
         return label.boxed();
     }
     let e = expr(names);
     let proxy = (select(macros), e.clone(), e).prop_map(|((target, is_2d), u, w)| {
         if is_2d {
-            Endpoint::Surface { target, u, w }
+            Endpoint::Surface {
+                target: target.into(),
+                u,
+                w,
+            }
         } else {
-            Endpoint::Line { target, alpha: u }
+            Endpoint::Line {
+                target: target.into(),
+                alpha: u,
+            }
         }
     });
     prop_oneof![label, proxy].boxed()
@@ -333,7 +340,7 @@ fn spec() -> impl Strategy<Value = ModelSpec> {
                     let tag_xy =
                         (tagged && kind.is_single_mass() && !buffers.is_empty()).then_some((x, y));
                     Element {
-                        label,
+                        label: label.into(),
                         kind,
                         buffers,
                         tag_xy,

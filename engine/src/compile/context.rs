@@ -67,7 +67,7 @@ impl<'a> Cx<'a> {
     pub fn error(&mut self, element: Option<usize>, kind: CompileErrorKind) {
         let (label, span) = match element {
             Some(i) => (
-                self.spec.elements[i].label.clone(),
+                self.spec.elements[i].label.to_string(),
                 self.spec.elements[i].span,
             ),
             None => (String::new(), Span::default()),

@@ -124,7 +124,7 @@ impl<'a> Cx<'a> {
                 index: point,
             };
             avatars.push((i, route));
-            io.use_input(*channel, InputUse::Position(e.label.clone()));
+            io.use_input(*channel, InputUse::Position(e.label.to_string()));
         }
         for r in &params.audio {
             let name = spec.params[r.index as usize].name.clone();

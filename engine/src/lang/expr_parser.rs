@@ -42,7 +42,7 @@ enum Tok {
 
 /// Where a name is being resolved from, for messages.
 pub(crate) struct ExprContext<'a> {
-    pub symbols: &'a Symbols,
+    pub symbols: &'a Symbols<'a>,
     pub line: u32,
     pub label: Option<&'a str>,
 }

@@ -55,13 +55,13 @@ pub(crate) struct Token<'a> {
     pub inner_col: u32,
 }
 
-impl Token<'_> {
+impl<'a> Token<'a> {
     pub(crate) fn string(&self) -> String {
         self.text.to_string()
     }
 
     /// The text after the first character: a label token's label, without its `@`.
-    pub(crate) fn label(&self) -> &str {
+    pub(crate) fn label(&self) -> &'a str {
         after_first(self.text)
     }
 

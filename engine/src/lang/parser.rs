@@ -177,7 +177,7 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
 /// Pass 2: the spec being built, the open buffer scopes, and the diagnostics.
 struct Builder<'s> {
     diags: Diags,
-    symbols: &'s Symbols,
+    symbols: &'s Symbols<'s>,
     /// Every item's tokens (see `Item::tokens`).
     tokens: &'s [Token<'s>],
     spec: ModelSpec,

@@ -218,7 +218,7 @@ fn element_line(e: &Element, spec: &ModelSpec) -> (String, Option<u32>) {
         ElementKind::PosOutput { channel, .. } | ElementKind::FrcOutput { channel, .. } => {
             format!("out{channel}")
         }
-        _ => e.label.clone(),
+        _ => e.label.to_string(),
     };
     let mut args: Vec<String> = Vec::new();
     let keyword = match &e.kind {

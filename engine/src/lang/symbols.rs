@@ -2,6 +2,7 @@
 //! (spec §3.4), for name resolution and endpoint checks.
 
 use crate::compile::label_map::LabelMap;
+use std::borrow::Cow;
 use std::collections::hash_map::Entry;
 use std::collections::HashSet;
 
@@ -47,10 +48,11 @@ pub(crate) struct Symbol {
     pub generated: bool,
 }
 
-/// Every label of a script (spec §3.4), for name resolution and endpoint checks.
+/// Every label of a script (spec §3.4), for name resolution and endpoint checks. A command's
+/// label borrows the script's text; a generated one is owned.
 #[derive(Debug, Default)]
-pub(crate) struct Symbols {
-    map: LabelMap<String, Symbol>,
+pub(crate) struct Symbols<'a> {
+    map: LabelMap<Cow<'a, str>, Symbol>,
     /// Some label names a macro: only then can an endpoint be a legacy bare connection point.
     has_macros: bool,
     /// Names of `~generate` directives that have an error: their labels are not known, so any
@@ -59,9 +61,9 @@ pub(crate) struct Symbols {
     broken_generators: HashSet<String>,
 }
 
-impl Symbols {
+impl<'a> Symbols<'a> {
     /// An empty table with room for `labels` labels.
-    pub(crate) fn with_capacity(labels: usize) -> Symbols {
+    pub(crate) fn with_capacity(labels: usize) -> Symbols<'a> {
         Symbols {
             map: LabelMap::with_capacity_and_hasher(labels, Default::default()),
             ..Symbols::default()
@@ -90,16 +92,20 @@ impl Symbols {
         self.map.get(name).copied()
     }
 
-    pub(crate) fn insert(&mut self, name: String, symbol: Symbol) {
+    pub(crate) fn insert(&mut self, name: impl Into<Cow<'a, str>>, symbol: Symbol) {
         self.has_macros |= matches!(symbol.kind, SymKind::Macro { .. });
-        self.map.insert(name, symbol);
+        self.map.insert(name.into(), symbol);
     }
 
     /// Declares `name` as `symbol`, unless it is declared already: then returns the name and
     /// the earlier declaration.
-    pub(crate) fn declare(&mut self, name: String, symbol: Symbol) -> Result<(), (String, Symbol)> {
-        match self.map.entry(name) {
-            Entry::Occupied(prev) => Err((prev.key().clone(), *prev.get())),
+    pub(crate) fn declare(
+        &mut self,
+        name: impl Into<Cow<'a, str>>,
+        symbol: Symbol,
+    ) -> Result<(), (String, Symbol)> {
+        match self.map.entry(name.into()) {
+            Entry::Occupied(prev) => Err((prev.key().to_string(), *prev.get())),
             Entry::Vacant(slot) => {
                 self.has_macros |= matches!(symbol.kind, SymKind::Macro { .. });
                 slot.insert(symbol);

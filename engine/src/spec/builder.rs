@@ -86,7 +86,7 @@ impl ModelBuilder {
     /// Appends an element with the currently open scopes.
     pub fn element(&mut self, label: &str, kind: ElementKind) -> &mut Self {
         self.spec.elements.push(Element {
-            label: label.to_string(),
+            label: label.into(),
             kind,
             buffers: self.open_scopes.clone(),
             tag_xy: None,

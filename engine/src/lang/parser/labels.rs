@@ -10,7 +10,11 @@ use crate::lang::symbols::{SymKind, Symbol, Symbols};
 /// Pass 1: every label (spec §3.4: names and elements may be used before their declaration
 /// line), those a `~generate` directive creates included (§4), with duplicates reported.
 /// A `~generate` directive is read here and kept on its item for pass 2.
-pub(super) fn declare_labels(items: &mut [Item], all: &[Token], diags: &mut Diags) -> Symbols {
+pub(super) fn declare_labels<'a>(
+    items: &mut [Item],
+    all: &[Token<'a>],
+    diags: &mut Diags,
+) -> Symbols<'a> {
     let mut symbols = Symbols::with_capacity(items.len());
     let mut budget = MAX_GENERATED_ELEMENTS;
     for item in items.iter_mut() {
@@ -59,7 +63,7 @@ pub(super) fn declare_labels(items: &mut [Item], all: &[Token], diags: &mut Diag
             col: first.col,
             generated: false,
         };
-        if let Err((label, prev)) = symbols.declare(label.to_string(), symbol) {
+        if let Err((label, prev)) = symbols.declare(label, symbol) {
             let message = if prev.generated {
                 format!(
                     "duplicate label `@{label}`: the `~generate` at line {} column {} \
