@@ -103,7 +103,17 @@ fn exact_decimal(text: &[u8]) -> Option<f64> {
     if digits == 0 || m > 1 << 53 {
         return None;
     }
-    let power = EXACT_POWERS_OF_TEN.get(frac.unwrap_or(0))?;
+    // Trailing zeros after the point (`1.0`, `0.50`) divide out exactly: the same real number,
+    // so the same rounded value, and often no division at all.
+    let mut frac = frac.unwrap_or(0);
+    while frac > 0 && m % 10 == 0 {
+        m /= 10;
+        frac -= 1;
+    }
+    if frac == 0 {
+        return Some(m as f64);
+    }
+    let power = EXACT_POWERS_OF_TEN.get(frac)?;
     Some(m as f64 / power)
 }
 
