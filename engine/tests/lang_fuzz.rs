@@ -5,12 +5,25 @@ use proptest::prelude::*;
 use ressort_engine::lang::{parse, parse_bytes, print, Parsed};
 use std::time::{Duration, Instant};
 
-/// Parses and, when that succeeds, prints and re-parses; checks the basic invariants.
-fn check(parsed: &Parsed) {
+/// The number of characters of each line of `text` (spec §3.2: CR LF, CR and LF end a line).
+fn line_widths(text: &str) -> Vec<usize> {
+    text.replace("\r\n", "\n")
+        .split(['\r', '\n'])
+        .map(|l| l.chars().count())
+        .collect()
+}
+
+/// Parses and, when that succeeds, prints and re-parses; checks the basic invariants. `text`
+/// is the script as characters (bytes decoded lossily): every diagnostic stands on one of its
+/// lines, at a column counted in characters, at most one past the line's end.
+fn check(text: &str, parsed: &Parsed) {
     let has_error = parsed.errors().next().is_some();
     assert_eq!(parsed.spec.is_none(), has_error);
+    let widths = line_widths(text);
     for d in &parsed.diagnostics {
         assert!(d.line >= 1 && d.col >= 1, "{d:?}");
+        let width = widths.get(d.line as usize - 1).copied().unwrap_or(0);
+        assert!(d.col as usize <= width + 1, "{d:?} on a line of {width} characters");
         let _ = d.to_string();
     }
     if let Some(spec) = &parsed.spec {
@@ -53,18 +66,18 @@ proptest! {
 
     #[test]
     fn arbitrary_strings_never_panic(s in any::<String>()) {
-        check(&parse(&s));
+        check(&s, &parse(&s));
     }
 
     #[test]
     fn scripty_strings_never_panic(s in scripty()) {
-        check(&parse(&s));
+        check(&s, &parse(&s));
     }
 
     #[test]
     fn arbitrary_bytes_never_panic(b in proptest::collection::vec(any::<u8>(), 0..400)) {
         let parsed = parse_bytes(&b);
-        check(&parsed);
+        check(&String::from_utf8_lossy(&b), &parsed);
         if std::str::from_utf8(&b).is_ok() {
             prop_assert_eq!(parsed, parse(std::str::from_utf8(&b).unwrap()));
         } else {
@@ -100,8 +113,9 @@ fn megabytes_of_garbage() {
             }
         })
         .collect();
-    check(&parse_bytes(&biased));
-    check(&parse(&String::from_utf8_lossy(&biased)));
+    let lossy = String::from_utf8_lossy(&biased);
+    check(&lossy, &parse_bytes(&biased));
+    check(&lossy, &parse(&lossy));
     let raw: Vec<u8> = (0..4 << 20).map(|_| rng.next() as u8).collect();
     let parsed = parse_bytes(&raw);
     assert!(parsed.spec.is_none());
@@ -183,7 +197,7 @@ fn adversarial_shapes() {
     for (i, text) in cases.iter().enumerate() {
         let start = Instant::now();
         let parsed = parse(text);
-        check(&parsed);
+        check(text, &parsed);
         assert!(
             start.elapsed() < Duration::from_secs(30),
             "case {i} took {:?}",
