@@ -53,8 +53,7 @@ pub use lang::{parse, parse_bytes, print, Diagnostic, DiagnosticCode, Parsed, Se
 pub use motion::{MotionLayout, MotionStore, NamedBuffer};
 pub use spec::{
     Element, ElementKind, Endpoint, HostSpec, Label, Law, MacroKind, MacroRange, MacroSpec,
-    ModelBuilder,
-    ModelSpec, ParamDecl, ParamKind, Route, RouteSource, SampleRateMode, ScaleClass, Span, Vector,
-    REFERENCE_SAMPLE_RATE_HZ,
+    ModelBuilder, ModelSpec, ParamDecl, ParamKind, Route, RouteSource, SampleRateMode, ScaleClass,
+    Span, Vector, REFERENCE_SAMPLE_RATE_HZ,
 };
 pub use stability::{MassStability, StabilityReport, StabilityWarning};

@@ -23,7 +23,10 @@ fn check(text: &str, parsed: &Parsed) {
     for d in &parsed.diagnostics {
         assert!(d.line >= 1 && d.col >= 1, "{d:?}");
         let width = widths.get(d.line as usize - 1).copied().unwrap_or(0);
-        assert!(d.col as usize <= width + 1, "{d:?} on a line of {width} characters");
+        assert!(
+            d.col as usize <= width + 1,
+            "{d:?} on a line of {width} characters"
+        );
         let _ = d.to_string();
     }
     if let Some(spec) = &parsed.spec {

@@ -124,7 +124,10 @@ const BARE_ASCII: [bool; 256] = {
     let mut table = [false; 256];
     let mut b = 0;
     while b < 128 {
-        table[b] = !matches!(b as u8, b'\t'..=b'\r' | b' ' | b'+' | b'[' | b']' | b'\'' | b'#');
+        table[b] = !matches!(
+            b as u8,
+            b'\t'..=b'\r' | b' ' | b'+' | b'[' | b']' | b'\'' | b'#'
+        );
         b += 1;
     }
     table
@@ -151,7 +154,8 @@ fn ends_with_exponent_marker(tok: &str) -> bool {
         .take_while(|b| b.is_ascii_digit() || *b == b'.')
         .count();
     let (before, mantissa) = rest.split_at(rest.len() - mantissa_len);
-    if !mantissa.bytes().any(|b| b.is_ascii_digit()) || mantissa.bytes().filter(|b| *b == b'.').count() > 1
+    if !mantissa.bytes().any(|b| b.is_ascii_digit())
+        || mantissa.bytes().filter(|b| *b == b'.').count() > 1
     {
         return false;
     }
@@ -395,6 +399,9 @@ mod tests {
             split_items("@s (a + b)  c"),
             vec![("@s", 0), ("(a + b)", 3), ("c", 12)]
         );
-        assert_eq!(split_items("é\t(ü b) c"), vec![("é", 0), ("(ü b)", 2), ("c", 8)]);
+        assert_eq!(
+            split_items("é\t(ü b) c"),
+            vec![("é", 0), ("(ü b)", 2), ("c", 8)]
+        );
     }
 }

@@ -72,9 +72,7 @@ impl Builder<'_> {
                 };
                 ok.then(|| Endpoint::Label(name.into()))
             }
-            TokKind::Bracket if t.first_non_blank() == Some('@') => {
-                self.connection_point(t, at)
-            }
+            TokKind::Bracket if t.first_non_blank() == Some('@') => self.connection_point(t, at),
             _ => {
                 self.diags.push(
                     at.diag(

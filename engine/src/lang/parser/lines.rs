@@ -110,7 +110,10 @@ fn check_ignored_line(text: &str, line: u32, diags: &mut Diags) {
             break;
         }
         let before = text.len() - rest.len() + word_at;
-        words.push((col_of(text.get(..before).unwrap_or("")), word.get(..len).unwrap_or("").to_string()));
+        words.push((
+            col_of(text.get(..before).unwrap_or("")),
+            word.get(..len).unwrap_or("").to_string(),
+        ));
         rest = word.get(len..).unwrap_or("");
         if rest.starts_with('#') {
             break;
