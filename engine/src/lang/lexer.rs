@@ -232,14 +232,7 @@ fn lex_line<'a>(
                 let inner = |j: usize| text.get(i + 1..j).unwrap_or("");
                 match stop {
                     Some((j, Some(b']'))) => {
-                        let content = inner(j);
-                        tokens.push(Token {
-                            kind: TokKind::Bracket,
-                            text: content,
-                            col,
-                            inner_col: col_plus(col, 1),
-                        });
-                        col = col_plus(col, width(content).saturating_add(2));
+                        col = push_group(tokens, TokKind::Bracket, inner(j), col);
                         i = j + 1;
                     }
                     Some((j, Some(b'['))) => {
@@ -284,14 +277,12 @@ fn lex_line<'a>(
                     return None;
                 };
                 let j = i + 1 + len;
-                let content = text.get(i + 1..j).unwrap_or("");
-                tokens.push(Token {
-                    kind: TokKind::Quoted,
-                    text: content,
+                col = push_group(
+                    tokens,
+                    TokKind::Quoted,
+                    text.get(i + 1..j).unwrap_or(""),
                     col,
-                    inner_col: col_plus(col, 1),
-                });
-                col = col_plus(col, width(content).saturating_add(2));
+                );
                 i = j + 1;
             }
             _ => {
@@ -325,6 +316,18 @@ fn lex_line<'a>(
         }
     }
     Some(())
+}
+
+/// Pushes a bracket or quoted group whose opening character stands at `col`; returns the column
+/// after its closing character.
+fn push_group<'a>(tokens: &mut Vec<Token<'a>>, kind: TokKind, content: &'a str, col: u32) -> u32 {
+    tokens.push(Token {
+        kind,
+        text: content,
+        col,
+        inner_col: col_plus(col, 1),
+    });
+    col_plus(col, width(content).saturating_add(2))
 }
 
 /// An item of a bracket's content: its text and its offset in columns from the content's
