@@ -418,6 +418,20 @@ impl Program {
         Ok(())
     }
 
+    /// Appends the constant `v`, as [`Program::push`] appends `Expr::Num(v)`: the commonest
+    /// argument, without the tree walk.
+    pub(crate) fn push_const(&mut self, v: f64) -> ExprRef {
+        let start = self.ops.len() as u32;
+        self.ops.push(Op::Const(v));
+        self.max_stack = self.max_stack.max(1);
+        ExprRef { start, len: 1 }
+    }
+
+    /// Room for `ops` more instructions.
+    pub(crate) fn reserve(&mut self, ops: usize) {
+        self.ops.reserve(ops);
+    }
+
     /// The parameter slots `e` reads (repeated if it reads one twice).
     pub(crate) fn params_read(&self, e: ExprRef) -> impl Iterator<Item = u32> + '_ {
         self.ops[e.start as usize..(e.start + e.len) as usize]

@@ -8,11 +8,46 @@ use crate::engine::{ArgClass, Binding, Proxies};
 use crate::expr::{Expr, ExprRef, Program};
 use crate::spec::{ElementKind, Endpoint, ModelSpec, Span};
 
-/// What a label resolves to.
+/// What a label resolves to: a parameter, or an element with what it is.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Symbol {
     Param(u32),
-    Element(usize),
+    Element(usize, Role),
+}
+
+/// What an element is, as an endpoint or target sees it: found once, when its label is
+/// declared, so that resolving an endpoint does not read the element again.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Role {
+    /// A single mass or an avatar: it has one point.
+    Point,
+    Macro,
+    Interaction,
+    ForceInput,
+    Output,
+}
+
+impl Role {
+    pub fn of(kind: &ElementKind) -> Role {
+        match kind {
+            ElementKind::Macro(_) => Role::Macro,
+            ElementKind::Interaction { .. } => Role::Interaction,
+            ElementKind::FrcInput { .. } => Role::ForceInput,
+            ElementKind::PosOutput { .. } | ElementKind::FrcOutput { .. } => Role::Output,
+            _ => Role::Point,
+        }
+    }
+
+    /// The role in an error message.
+    fn describe(self) -> &'static str {
+        match self {
+            Role::Point => "a point",
+            Role::Macro => "a macro",
+            Role::Interaction => "an interaction",
+            Role::ForceInput => "a force input",
+            Role::Output => "an output",
+        }
+    }
 }
 
 /// Compile-time state, shared by the passes: the symbol table, the errors, and the argument
@@ -43,6 +78,12 @@ pub(super) struct Cx<'a> {
 
 impl<'a> Cx<'a> {
     pub fn new(spec: &'a ModelSpec) -> Cx<'a> {
+        // About four arguments an element (a mass binds four and has two initial values, a
+        // link binds two), each most often a one-instruction program: room for a script
+        // written element by element, so that binding does not grow these arrays step by step.
+        let args = 4 * spec.elements.len();
+        let mut program = Program::default();
+        program.reserve(args);
         Cx {
             spec,
             symbols: LabelMap::with_capacity_and_hasher(
@@ -50,9 +91,9 @@ impl<'a> Cx<'a> {
                 Default::default(),
             ),
             errors: Vec::new(),
-            program: Program::default(),
-            args: Vec::new(),
-            control_bindings: Vec::new(),
+            program,
+            args: Vec::with_capacity(args),
+            control_bindings: Vec::with_capacity(args),
             audio_bindings: Vec::new(),
             param_is_audio: Vec::new(),
             param_is_coordinate: Vec::new(),
@@ -87,7 +128,7 @@ impl<'a> Cx<'a> {
         for n in names {
             match self.symbols.get(n.as_str()) {
                 Some(Symbol::Param(_)) => {}
-                Some(Symbol::Element(_)) => {
+                Some(Symbol::Element(..)) => {
                     self.error(Some(element), CompileErrorKind::NotAParameter(n));
                     ok = false;
                 }
@@ -130,13 +171,9 @@ impl<'a> Cx<'a> {
     /// Compiles `expr` into the program. Invalid expressions become NaN constants (the
     /// model is not built anyway, since an error was recorded).
     pub fn expr(&mut self, expr: &Expr, element: usize) -> (ExprRef, bool) {
-        if let Expr::Num(_) = expr {
+        if let Expr::Num(v) = expr {
             // The commonest argument: nothing to check, resolve or mark audio-rate.
-            let r = self
-                .program
-                .push(expr, &|_| None)
-                .expect("a number names nothing");
-            return (r, false);
+            return (self.program.push_const(*v), false);
         }
         let valid = self.check_expr(expr, element);
         let nan = Expr::Num(f64::NAN);
@@ -213,19 +250,9 @@ impl<'a> Cx<'a> {
             );
             return None;
         };
-        let found = match symbol {
-            Symbol::Param(_) => "a parameter",
-            Symbol::Element(j) => match &self.spec.elements[j].kind {
-                ElementKind::Macro(_) => "a macro",
-                ElementKind::Interaction { .. } => "an interaction",
-                ElementKind::FrcInput { .. } => "a force input",
-                ElementKind::PosOutput { .. } | ElementKind::FrcOutput { .. } => "an output",
-                _ => "a point",
-            },
-        };
         match (ep, symbol) {
-            (Endpoint::Label(_), Symbol::Element(j)) if found == "a point" => self.element_point[j],
-            (Endpoint::Label(_), _) if found == "a macro" => {
+            (Endpoint::Label(_), Symbol::Element(j, Role::Point)) => self.element_point[j],
+            (Endpoint::Label(_), Symbol::Element(_, Role::Macro)) => {
                 self.error(
                     Some(element),
                     CompileErrorKind::BareMacroReference(target.to_string()),
@@ -233,6 +260,10 @@ impl<'a> Cx<'a> {
                 None
             }
             (Endpoint::Label(_), _) => {
+                let found = match symbol {
+                    Symbol::Param(_) => "a parameter",
+                    Symbol::Element(_, role) => role.describe(),
+                };
                 self.error(
                     Some(element),
                     CompileErrorKind::NotAPoint {
@@ -242,9 +273,7 @@ impl<'a> Cx<'a> {
                 );
                 None
             }
-            (Endpoint::Line { .. } | Endpoint::Surface { .. }, Symbol::Element(j))
-                if found == "a macro" =>
-            {
+            (Endpoint::Line { .. } | Endpoint::Surface { .. }, Symbol::Element(j, Role::Macro)) => {
                 let ElementKind::Macro(mac) = &self.spec.elements[j].kind else {
                     return None;
                 };

@@ -2,7 +2,7 @@
 //! the symbol table, reports duplicate labels and invalid parameter names, and reads every
 //! parameter's declared value and audio input.
 
-use super::context::{Cx, Symbol};
+use super::context::{Cx, Role, Symbol};
 use super::errors::{CompileError, CompileErrorKind};
 use crate::engine::Route;
 use crate::expr::Func;
@@ -53,7 +53,7 @@ impl Cx<'_> {
                     self.error(Some(i), CompileErrorKind::DuplicateLabel { first });
                 }
                 Entry::Vacant(slot) => {
-                    slot.insert(Symbol::Element(i));
+                    slot.insert(Symbol::Element(i, Role::of(&e.kind)));
                 }
             }
         }
@@ -124,7 +124,7 @@ impl Cx<'_> {
 fn symbol_span(spec: &crate::spec::ModelSpec, symbol: Symbol) -> crate::spec::Span {
     match symbol {
         Symbol::Param(id) => spec.params[id as usize].span,
-        Symbol::Element(i) => spec.elements[i].span,
+        Symbol::Element(i, _) => spec.elements[i].span,
     }
 }
 

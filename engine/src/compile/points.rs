@@ -34,12 +34,29 @@ impl Cx<'_> {
     /// model with more than [`MAX_POINTS`] points is reported once, with its full count.
     pub fn number_points(&mut self) -> Numbering {
         let spec = self.spec;
-        let mut owners = Vec::new();
-        let mut points: Vec<PointInfo> = Vec::new();
-        let mut owner_element = Vec::new();
+        // Single masses first, then macros, then avatars: one sweep of the elements sorts
+        // them, and sizes the arrays of the points that are not macro nodes.
+        let mut by_pass: [Vec<usize>; 3] = [
+            Vec::with_capacity(spec.elements.len()),
+            Vec::new(),
+            Vec::new(),
+        ];
+        for (i, e) in spec.elements.iter().enumerate() {
+            match &e.kind {
+                k if k.is_single_mass() => by_pass[0].push(i),
+                ElementKind::Macro(_) => by_pass[1].push(i),
+                ElementKind::PosInput { .. } => by_pass[2].push(i),
+                _ => {}
+            }
+        }
+        let owner_count = by_pass.iter().map(Vec::len).sum();
+        let mut owners = Vec::with_capacity(owner_count);
+        let mut owner_element = Vec::with_capacity(owner_count);
+        let mut points: Vec<PointInfo> = Vec::with_capacity(by_pass[0].len() + by_pass[2].len());
         let mut too_large = false;
-        for pass in 0..3 {
-            for (i, e) in spec.elements.iter().enumerate() {
+        for (pass, elements) in by_pass.iter().enumerate() {
+            for &i in elements {
+                let e = &spec.elements[i];
                 let (count, kind, width) = match (&e.kind, pass) {
                     (ElementKind::Mass { .. }, 0) => (1, PointKind::Mass, 0),
                     (ElementKind::Osc { .. }, 0) => (1, PointKind::Osc, 0),
@@ -92,8 +109,10 @@ impl Cx<'_> {
         // The macros' fixed nodes, in script order.
         let mut fixed_points = Vec::new();
         let mut macros = Vec::new();
-        for (i, e) in spec.elements.iter().enumerate() {
-            let (ElementKind::Macro(mac), Some(base)) = (&e.kind, self.element_point[i]) else {
+        for &i in &by_pass[1] {
+            let (ElementKind::Macro(mac), Some(base)) =
+                (&spec.elements[i].kind, self.element_point[i])
+            else {
                 continue;
             };
             let fixed = fixed_nodes(mac);
