@@ -79,37 +79,31 @@ const EXACT_POWERS_OF_TEN: [f64; 23] = [
     1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
 ];
 
-/// A literal `digits[.digits]` (no sign, no exponent) whose digits, read as an integer m, are at
-/// most 2^53, with at most 22 after the point: m and 10^f are then exact in f64, and one
+/// A literal `digits[.digits]` (no sign, no exponent) of at most 19 digits which, read as an
+/// integer m, are at most 2^53: m and 10^f (f ≤ 19 digits after the point) are then exact in
+/// f64, and one
 /// correctly rounded division gives the correctly rounded value, the same as `str::parse`
 /// (Clinger's fast path, which the standard library takes too). `None` for anything else.
 fn exact_decimal(text: &[u8]) -> Option<f64> {
+    // One pass: at most 19 digits cannot overflow a u64, and the bound on m is checked after.
     let mut m: u64 = 0;
     let mut digits = 0usize;
-    let mut frac: Option<usize> = None;
+    let mut point: Option<usize> = None;
     for &c in text {
-        match c {
-            b'0'..=b'9' => {
-                m = m.checked_mul(10)?.checked_add(u64::from(c - b'0'))?;
-                digits += 1;
-                if let Some(f) = frac.as_mut() {
-                    *f += 1;
-                }
-            }
-            b'.' if frac.is_none() => frac = Some(0),
-            _ => return None,
+        let d = c.wrapping_sub(b'0');
+        if d < 10 {
+            m = m.wrapping_mul(10).wrapping_add(u64::from(d));
+            digits += 1;
+        } else if c == b'.' && point.is_none() {
+            point = Some(digits);
+        } else {
+            return None;
         }
     }
-    if digits == 0 || m > 1 << 53 {
+    if digits == 0 || digits > 19 || m > 1 << 53 {
         return None;
     }
-    // Trailing zeros after the point (`1.0`, `0.50`) divide out exactly: the same real number,
-    // so the same rounded value, and often no division at all.
-    let mut frac = frac.unwrap_or(0);
-    while frac > 0 && m % 10 == 0 {
-        m /= 10;
-        frac -= 1;
-    }
+    let frac = digits - point.unwrap_or(digits);
     if frac == 0 {
         return Some(m as f64);
     }
@@ -142,6 +136,10 @@ pub(crate) fn parse_number_literal(text: &str) -> Result<f64, NumberError> {
 /// anything else, a non-finite literal included, which the parser then reads and reports.
 pub(crate) fn plain_number(text: &str) -> Option<f64> {
     let (negative, body) = split_sign(text);
+    // A literal `exact_decimal` reads is one `scan_number` accepts whole: no second pass.
+    if let Some(v) = exact_decimal(body.as_bytes()) {
+        return Some(if negative { -v } else { v });
+    }
     if scan_number(body.as_bytes(), 0)? != body.len() {
         return None;
     }
