@@ -77,7 +77,6 @@ impl ControlArgs {
         proxy_slots: impl Iterator<Item = usize>,
     ) -> ControlArgs {
         let mut count = vec![0u32; num_params + 1];
-        let mut reads: Vec<Vec<u32>> = Vec::with_capacity(bindings.len());
         let mut rescale: [Vec<u32>; NUM_ARG_CLASSES] = Default::default();
         let mut rescale_derived: [Vec<u32>; NUM_ARG_CLASSES] = Default::default();
         let num_slots = args.len();
@@ -94,15 +93,24 @@ impl ControlArgs {
                 *d = PROXY_DEP;
             }
         }
+        // Two sweeps of the bindings: count each parameter's readers, then list them. A
+        // binding that reads a parameter twice is listed once. (An expression reads a few
+        // parameters at most, so finding its distinct ones needs no allocation.)
+        let params_of = |e| {
+            program
+                .params_read(e)
+                .enumerate()
+                .filter(move |&(k, p)| !program.params_read(e).take(k).any(|q| q == p))
+                .map(|(_, p)| p)
+        };
         let mut stack = program.new_stack().0;
         for (i, b) in bindings.iter().enumerate() {
-            let mut ps: Vec<u32> = program.params_read(b.expr).collect();
-            ps.sort_unstable();
-            ps.dedup();
-            for &p in &ps {
+            let mut reads_none = true;
+            for p in params_of(b.expr) {
                 count[p as usize + 1] += 1;
+                reads_none = false;
             }
-            let constant_zero = ps.is_empty() && program.eval(b.expr, &[], &mut stack) == 0.0;
+            let constant_zero = reads_none && program.eval(b.expr, &[], &mut stack) == 0.0;
             if !constant_zero {
                 let c = b.class as usize;
                 match slot_dep[b.slot as usize] {
@@ -110,7 +118,6 @@ impl ControlArgs {
                     _ => rescale_derived[c].push(i as u32),
                 }
             }
-            reads.push(ps);
         }
         let mut reader_start = count;
         for p in 0..num_params {
@@ -118,10 +125,12 @@ impl ControlArgs {
         }
         let mut fill = reader_start.clone();
         let mut readers = vec![0; reader_start[num_params] as usize];
-        for (i, ps) in reads.iter().enumerate() {
-            for &p in ps {
-                readers[fill[p as usize] as usize] = i as u32;
-                fill[p as usize] += 1;
+        if !readers.is_empty() {
+            for (i, b) in bindings.iter().enumerate() {
+                for p in params_of(b.expr) {
+                    readers[fill[p as usize] as usize] = i as u32;
+                    fill[p as usize] += 1;
+                }
             }
         }
         debug_assert!(
