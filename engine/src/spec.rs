@@ -18,6 +18,17 @@ pub use host::{HostSpec, MacroRange, Route, RouteSource};
 /// clone copies. Compares with, hashes as and dereferences to its `str`.
 pub type Label = smol_str::SmolStr;
 
+/// `text` as a [`Label`]: the same value as `Label::new`, built without its general path
+/// (a copy call and a check for whitespace-only strings) when it fits inline.
+#[inline]
+pub(crate) fn label(text: &str) -> Label {
+    if text.len() <= 23 {
+        Label::new_inline(text)
+    } else {
+        Label::new(text)
+    }
+}
+
 /// Where a construct stood in its script: 1-based line and column (Unicode scalar values, a
 /// tab counting as one). `0:0` means "not from a script" (built in Rust).
 ///
@@ -459,5 +470,37 @@ impl ModelSpec {
     /// The parameter named `name`.
     pub fn param(&self, name: &str) -> Option<&ParamDecl> {
         self.params.iter().find(|p| p.name == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_built_inline_equal_the_general_ones() {
+        for text in [
+            "",
+            "n",
+            "n0",
+            "string_1000_node_99999",
+            "é-ü",
+            "a\u{1F600}b",
+            "  ",
+            "\n\n",
+        ]
+        .into_iter()
+        .map(String::from)
+        .chain((20..=26).map(|n| "x".repeat(n)))
+        {
+            let (fast, general) = (label(&text), Label::new(&text));
+            assert_eq!(fast, general, "{text:?}");
+            assert_eq!(fast.as_str(), text);
+            assert_eq!(
+                fast.is_heap_allocated(),
+                general.is_heap_allocated(),
+                "{text:?}"
+            );
+        }
     }
 }

@@ -121,7 +121,7 @@ impl Builder<'_> {
             tag_xy = Some((tag.x, tag.y));
         }
         self.spec.elements.push(Element {
-            label: label.into(),
+            label: crate::spec::label(label),
             kind,
             buffers,
             tag_xy,

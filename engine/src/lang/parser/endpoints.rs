@@ -7,7 +7,7 @@ use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::legacy;
 use crate::lang::lexer::{after_first, col_plus, split_items, TokKind, Token};
 use crate::lang::symbols::SymKind;
-use crate::spec::{Endpoint, Label};
+use crate::spec::{label, Endpoint};
 
 impl Builder<'_> {
     /// An endpoint or target (spec §3.4, §2.8): `@label` of a point, or `[@macro α]` /
@@ -70,7 +70,7 @@ impl Builder<'_> {
                         false
                     }
                 };
-                ok.then(|| Endpoint::Label(name.into()))
+                ok.then(|| Endpoint::Label(label(name)))
             }
             TokKind::Bracket if t.first_non_blank() == Some('@') => self.connection_point(t, at),
             _ => {
@@ -102,7 +102,7 @@ impl Builder<'_> {
             return self.endpoint(args.get(slot)?, at);
         };
         let coords: Vec<Option<Expr>> = p.coords.iter().map(|t| self.expr(t, at)).collect();
-        let target = Label::from(p.target.as_str());
+        let target = label(p.target.as_str());
         match <[Option<Expr>; 2]>::try_from(coords) {
             Ok([u, w]) => Some(Endpoint::Surface {
                 target,
@@ -119,7 +119,7 @@ impl Builder<'_> {
     fn connection_point(&mut self, t: &Token, at: At<'_>) -> Option<Endpoint> {
         let items = split_items(t.text);
         let &(first, offset) = items.first()?;
-        let target = Label::from(after_first(first));
+        let target = label(after_first(first));
         let target_col = col_plus(t.inner_col, offset);
         if target.is_empty() || target.contains(['(', ')']) {
             self.diags.push(
