@@ -6,11 +6,18 @@ use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::expr_parser::{parse_expression, ExprContext};
 use crate::lang::lexer::{col_plus, is_blank, split_items, BracketItem, TokKind, Token};
+use crate::lang::numbers::plain_number;
 use crate::lang::symbols::SymKind;
 use crate::spec::Vector;
 
 impl Builder<'_> {
     pub(super) fn expr(&mut self, t: &Token, at: At<'_>) -> Option<Expr> {
+        // The commonest argument, a signed literal, is none of the cases checked below.
+        if t.kind == TokKind::Bare {
+            if let Some(v) = plain_number(t.text) {
+                return Some(Expr::Num(v));
+            }
+        }
         if t.kind == TokKind::Bracket && t.first_non_blank() == Some('@') {
             self.diags.push(
                 at.diag(
