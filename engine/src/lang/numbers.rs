@@ -81,9 +81,9 @@ const EXACT_POWERS_OF_TEN: [f64; 23] = [
 
 /// A literal `digits[.digits]` (no sign, no exponent) of at most 19 digits which, read as an
 /// integer m, are at most 2^53: m and 10^f (f ≤ 19 digits after the point) are then exact in
-/// f64, and one
-/// correctly rounded division gives the correctly rounded value, the same as `str::parse`
-/// (Clinger's fast path, which the standard library takes too). `None` for anything else.
+/// f64, and one correctly rounded division gives the correctly rounded value, the same as
+/// `str::parse` (Clinger's fast path, which the standard library takes too). `None` for
+/// anything else.
 fn exact_decimal(text: &[u8]) -> Option<f64> {
     // One pass: at most 19 digits cannot overflow a u64, and the bound on m is checked after.
     let mut m: u64 = 0;
