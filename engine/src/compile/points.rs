@@ -34,8 +34,8 @@ impl Cx<'_> {
     /// model with more than [`MAX_POINTS`] points is reported once, with its full count.
     pub fn number_points(&mut self) -> Numbering {
         let spec = self.spec;
-        // Single masses first, then macros, then avatars: one sweep of the elements sorts
-        // them, and sizes the arrays of the points that are not macro nodes.
+        // Single masses first, then macros, then avatars, each in script order: one sweep of
+        // the elements sorts them, and sizes the arrays of the points that are not macro nodes.
         let mut by_pass: [Vec<usize>; 3] = [
             Vec::with_capacity(spec.elements.len()),
             Vec::new(),
@@ -54,15 +54,15 @@ impl Cx<'_> {
         let mut owner_element = Vec::with_capacity(owner_count);
         let mut points: Vec<PointInfo> = Vec::with_capacity(by_pass[0].len() + by_pass[2].len());
         let mut too_large = false;
-        for (pass, elements) in by_pass.iter().enumerate() {
+        for elements in &by_pass {
             for &i in elements {
                 let e = &spec.elements[i];
-                let (count, kind, width) = match (&e.kind, pass) {
-                    (ElementKind::Mass { .. }, 0) => (1, PointKind::Mass, 0),
-                    (ElementKind::Osc { .. }, 0) => (1, PointKind::Osc, 0),
-                    (ElementKind::Ground { .. }, 0) => (1, PointKind::Ground, 0),
-                    (ElementKind::MassG { .. }, 0) => (1, PointKind::MassG, 0),
-                    (ElementKind::Macro(m), 1) => {
+                let (count, kind, width) = match &e.kind {
+                    ElementKind::Mass { .. } => (1, PointKind::Mass, 0),
+                    ElementKind::Osc { .. } => (1, PointKind::Osc, 0),
+                    ElementKind::Ground { .. } => (1, PointKind::Ground, 0),
+                    ElementKind::MassG { .. } => (1, PointKind::MassG, 0),
+                    ElementKind::Macro(m) => {
                         let sizes_ok = self.check_macro_sizes(m, i);
                         if !sizes_ok {
                             continue;
@@ -70,7 +70,7 @@ impl Cx<'_> {
                         let w = if m.kind.is_2d() { m.width } else { 0 };
                         (m.num_nodes(), PointKind::MacroNode { fixed: false }, w)
                     }
-                    (ElementKind::PosInput { .. }, 2) => (1, PointKind::Avatar, 0),
+                    ElementKind::PosInput { .. } => (1, PointKind::Avatar, 0),
                     _ => continue,
                 };
                 if points.len() + count > MAX_POINTS {
