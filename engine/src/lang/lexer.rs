@@ -8,27 +8,57 @@ pub(crate) fn is_blank(c: char) -> bool {
     c.is_whitespace() || c == '\u{feff}'
 }
 
-/// Splits `text` into lines at CR LF, CR or LF (spec §3.2). Returns (1-based line number, line).
-pub(crate) fn split_lines(text: &str) -> Vec<(u32, &str)> {
-    let bytes = text.as_bytes();
-    let mut lines = Vec::with_capacity(memchr::memchr_iter(b'\n', bytes).count() + 1);
-    let mut start = 0;
-    let mut number: u32 = 1;
-    for i in memchr::memchr2_iter(b'\n', b'\r', bytes) {
-        if i < start {
-            continue; // the LF of a CR LF
-        }
-        lines.push((number, text.get(start..i).unwrap_or("")));
-        number = number.saturating_add(1);
-        start = i + 1;
-        if bytes.get(i) == Some(&b'\r') && bytes.get(i + 1) == Some(&b'\n') {
-            start += 1;
+/// The length of the line that starts `rest`: the offset of its break (CR or LF, spec §3.2) at
+/// or after byte `from`, or the length of `rest` when it is the last line.
+pub(crate) fn line_len(rest: &str, from: usize) -> usize {
+    let bytes = rest.as_bytes();
+    bytes
+        .get(from..)
+        .and_then(|b| memchr::memchr2(b'\n', b'\r', b))
+        .map_or(bytes.len(), |k| from + k)
+}
+
+/// A script read line by line (spec §3.2: a line ends at CR LF, CR or LF). The lexer reads a
+/// command line from its start and stops at its break, so that the script's bytes are scanned
+/// once; other lines find their break with [`line_len`].
+pub(crate) struct Lines<'a> {
+    text: &'a str,
+    /// The byte offset of the current line's start.
+    pos: usize,
+    /// The current line's 1-based number.
+    line: u32,
+}
+
+impl<'a> Lines<'a> {
+    pub(crate) fn new(text: &'a str) -> Lines<'a> {
+        Lines {
+            text,
+            pos: 0,
+            line: 1,
         }
     }
-    if start < bytes.len() {
-        lines.push((number, text.get(start..).unwrap_or("")));
+
+    /// The current line and the rest of the script after it (`None` after the last line).
+    pub(crate) fn rest(&self) -> Option<&'a str> {
+        self.text.get(self.pos..).filter(|r| !r.is_empty())
     }
-    lines
+
+    /// The current line's number.
+    pub(crate) fn number(&self) -> u32 {
+        self.line
+    }
+
+    /// Moves to the next line, the current one being `len` bytes long (up to its break).
+    pub(crate) fn advance(&mut self, len: usize) {
+        let bytes = self.text.as_bytes();
+        let end = self.pos + len;
+        self.pos = match (bytes.get(end), bytes.get(end + 1)) {
+            (Some(b'\r'), Some(b'\n')) => end + 2,
+            (Some(_), _) => end + 1,
+            (None, _) => end,
+        };
+        self.line = self.line.saturating_add(1);
+    }
 }
 
 /// The three token forms of spec §3.3.
@@ -133,13 +163,61 @@ const BARE_ASCII: [bool; 256] = {
     table
 };
 
-/// The length of the run of bare ASCII bytes at the start of `bytes`.
+/// The length of the run of bare ASCII bytes at the start of `bytes`: the scalar reference of
+/// [`bare_ascii_run`].
 #[inline]
-fn bare_ascii_run(bytes: &[u8]) -> usize {
+fn bare_ascii_run_scalar(bytes: &[u8]) -> usize {
     bytes
         .iter()
         .position(|&b| !BARE_ASCII[usize::from(b)])
         .unwrap_or(bytes.len())
+}
+
+/// Each byte of `w` repeated: `0x0101…01 × b`.
+const fn splat(b: u8) -> u64 {
+    0x0101_0101_0101_0101 * b as u64
+}
+
+const HIGH: u64 = splat(0x80);
+
+/// The high bit of every byte of `w` below `n` (`n` ≤ 0x80), and maybe of bytes above such a
+/// byte (a borrow): the lowest flagged byte is exact.
+#[inline]
+fn bytes_below(w: u64, n: u8) -> u64 {
+    w.wrapping_sub(splat(n)) & !w & HIGH
+}
+
+/// The high bit of every byte of `w` equal to `b`; the lowest flagged byte is exact.
+#[inline]
+fn bytes_equal(w: u64, b: u8) -> u64 {
+    bytes_below(w ^ splat(b), 1)
+}
+
+/// The length of the run of bare ASCII bytes at the start of `bytes`, eight bytes at a time:
+/// where the scalar loop's exit, taken once a token at an unpredictable length, costs a
+/// mispredicted branch, a word finds the first byte that may end the token without a branch.
+/// That is a byte below `+` (0x2b: blanks, `#`, `'` and a few bare punctuation marks), `+`,
+/// `[`, `]` or a non-ASCII byte; the few bare bytes among them (`!`, `(`, `*`, …) go on.
+/// Equal to [`bare_ascii_run_scalar`] (test `the_word_scan_equals_the_byte_scan`).
+#[inline]
+fn bare_ascii_run(bytes: &[u8]) -> usize {
+    let mut n = 0;
+    while let Some(chunk) = bytes.get(n..n + 8) {
+        let mut word = [0u8; 8];
+        word.copy_from_slice(chunk);
+        let w = u64::from_le_bytes(word);
+        let maybe = bytes_below(w, 0x2c) | (w & HIGH) | bytes_equal(w, b'[') | bytes_equal(w, b']');
+        if maybe == 0 {
+            n += 8;
+            continue;
+        }
+        let at = n + (maybe.trailing_zeros() / 8) as usize;
+        match bytes.get(at) {
+            Some(&b) if BARE_ASCII[usize::from(b)] => n = at + 1,
+            _ => return at,
+        }
+    }
+    n + bare_ascii_run_scalar(bytes.get(n..).unwrap_or(&[]))
 }
 
 /// True when `tok` (the bare token scanned so far) ends with the mantissa of a number followed
@@ -165,45 +243,49 @@ fn ends_with_exponent_marker(tok: &str) -> bool {
     }
 }
 
-/// Tokenises one command or directive line (spec §3.3) onto the end of `tokens`, the tokens
-/// of the whole script in one vector, and returns the line's range in it. A `#` outside a
-/// quoted group starts a comment (spec §3.2). Reports the first lexical error of the line and
-/// returns `None` then, with `tokens` as it was; warns about `+` separators between two
-/// non-blank characters.
+/// Tokenises the command or directive line that starts `rest` (spec §3.3) onto the end of
+/// `tokens`, the tokens of the whole script in one vector. Returns the line's range in it and
+/// the line's length in bytes (up to its break, which ends the lexing; `rest` goes on with the
+/// following lines). A `#` outside a quoted group starts a comment (spec §3.2). Reports the
+/// first lexical error of the line and returns no range then, with `tokens` as it was; warns
+/// about `+` separators between two non-blank characters.
 pub(crate) fn tokenize<'a>(
-    text: &'a str,
+    rest: &'a str,
     line: u32,
     diags: &mut Diags,
     tokens: &mut Vec<Token<'a>>,
-) -> Option<std::ops::Range<usize>> {
+) -> (Option<std::ops::Range<usize>>, usize) {
     let start = tokens.len();
-    let lexed = lex_line(text, line, diags, tokens);
-    if lexed.is_none() {
-        tokens.truncate(start);
+    match lex_line(rest, line, diags, tokens) {
+        Ok(len) => (Some(start..tokens.len()), len),
+        Err(at) => {
+            tokens.truncate(start);
+            (None, line_len(rest, at))
+        }
     }
-    lexed.map(|()| start..tokens.len())
 }
 
 /// The lexer's loop: `i` is a byte offset into the line and `col` its column, moved together
 /// (every character the lexer dispatches on is ASCII; other characters are stepped over whole).
+/// Returns the line's length, or the offset of its lexical error (reported).
 fn lex_line<'a>(
     text: &'a str,
     line: u32,
     diags: &mut Diags,
     tokens: &mut Vec<Token<'a>>,
-) -> Option<()> {
+) -> Result<usize, usize> {
     let bytes = text.as_bytes();
     let mut i = 0;
     let mut col: u32 = 1;
-    while let Some((c, len)) = char_at(text, i) {
-        if is_blank(c) {
-            i += len;
-            col = col_plus(col, 1);
-            continue;
-        }
-        match c {
-            '#' => break,
-            '+' => {
+    while let Some(&b) = bytes.get(i) {
+        match b {
+            b' ' | b'\t' | 0x0b | 0x0c => {
+                i += 1;
+                col = col_plus(col, 1);
+            }
+            b'\n' | b'\r' => return Ok(i),
+            b'#' => return Ok(line_len(text, i)),
+            b'+' => {
                 let prev = text.get(..i).and_then(|s| s.chars().next_back());
                 let next = text.get(i + 1..).and_then(|s| s.chars().next());
                 if let (Some(p), Some(n)) = (prev, next) {
@@ -223,11 +305,11 @@ fn lex_line<'a>(
                 i += 1;
                 col = col_plus(col, 1);
             }
-            '[' => {
+            b'[' => {
                 let after = bytes.get(i + 1..).unwrap_or(&[]);
                 let stop = after
                     .iter()
-                    .position(|b| matches!(b, b'#' | b'[' | b']'))
+                    .position(|b| matches!(b, b'#' | b'[' | b']' | b'\n' | b'\r'))
                     .map(|k| (i + 1 + k, bytes.get(i + 1 + k).copied()));
                 let inner = |j: usize| text.get(i + 1..j).unwrap_or("");
                 match stop {
@@ -243,7 +325,7 @@ fn lex_line<'a>(
                             "`[` inside a bracket group: bracket groups do not nest; use \
                              parentheses inside brackets",
                         ));
-                        return None;
+                        return Err(i);
                     }
                     _ => {
                         diags.push(Diagnostic::new(
@@ -252,29 +334,33 @@ fn lex_line<'a>(
                             col,
                             "unterminated `[`: no matching `]` on this line",
                         ));
-                        return None;
+                        return Err(i);
                     }
                 }
             }
-            ']' => {
+            b']' => {
                 diags.push(Diagnostic::new(
                     DiagnosticCode::StrayBracket,
                     line,
                     col,
                     "stray `]` without a matching `[`",
                 ));
-                return None;
+                return Err(i);
             }
-            '\'' => {
+            b'\'' => {
                 let after = bytes.get(i + 1..).unwrap_or(&[]);
-                let Some(len) = after.iter().position(|&b| b == b'\'') else {
+                let end = after
+                    .iter()
+                    .position(|&b| matches!(b, b'\'' | b'\n' | b'\r'))
+                    .filter(|&k| after.get(k) == Some(&b'\''));
+                let Some(len) = end else {
                     diags.push(Diagnostic::new(
                         DiagnosticCode::UnterminatedQuote,
                         line,
                         col,
                         "unterminated quote: no closing `'` on this line",
                     ));
-                    return None;
+                    return Err(i);
                 };
                 let j = i + 1 + len;
                 col = push_group(
@@ -286,6 +372,14 @@ fn lex_line<'a>(
                 i = j + 1;
             }
             _ => {
+                if !b.is_ascii() {
+                    let c = text.get(i..).and_then(|s| s.chars().next()).unwrap_or(' ');
+                    if is_blank(c) {
+                        i += c.len_utf8().max(1);
+                        col = col_plus(col, 1);
+                        continue;
+                    }
+                }
                 let (start, start_col) = (i, col);
                 loop {
                     let run = bare_ascii_run(bytes.get(i..).unwrap_or(&[]));
@@ -315,7 +409,7 @@ fn lex_line<'a>(
             }
         }
     }
-    Some(())
+    Ok(bytes.len())
 }
 
 /// Pushes a bracket or quoted group whose opening character stands at `col`; returns the column
@@ -371,8 +465,22 @@ mod tests {
     fn toks(s: &str) -> Vec<String> {
         let mut d = Diags::default();
         let mut tokens = Vec::new();
-        tokenize(s, 1, &mut d, &mut tokens).unwrap();
+        let (range, len) = tokenize(s, 1, &mut d, &mut tokens);
+        range.unwrap();
+        assert_eq!(len, line_len(s, 0));
         tokens.iter().map(Token::source).collect()
+    }
+
+    /// Every line of `text`: (number, content).
+    fn split_lines(text: &str) -> Vec<(u32, &str)> {
+        let mut lines = Lines::new(text);
+        let mut out = Vec::new();
+        while let Some(rest) = lines.rest() {
+            let len = line_len(rest, 0);
+            out.push((lines.number(), &rest[..len]));
+            lines.advance(len);
+        }
+        out
     }
 
     #[test]
@@ -381,6 +489,34 @@ mod tests {
         assert_eq!(l, vec![(1, "a"), (2, "b"), (3, "c"), (4, "d")]);
         assert_eq!(split_lines("a\n"), vec![(1, "a")]);
         assert_eq!(split_lines("\n\n"), vec![(1, ""), (2, "")]);
+        assert_eq!(split_lines("\r\n\r\r\n"), vec![(1, ""), (2, ""), (3, "")]);
+    }
+
+    #[test]
+    fn the_lexer_stops_at_the_line_break() {
+        for (text, want, len) in [
+            ("@a mass 1 # c\n@b", vec!["@a", "mass", "1"], 13),
+            ("@a [x y]\r\n@b", vec!["@a", "[x y]"], 8),
+            ("@a 'q'\r@b", vec!["@a", "'q'"], 6),
+            ("@a 1e+\n3", vec!["@a", "1e"], 6),
+        ] {
+            let mut d = Diags::default();
+            let mut tokens = Vec::new();
+            let (range, l) = tokenize(text, 1, &mut d, &mut tokens);
+            assert!(range.is_some(), "{text:?}");
+            let got: Vec<String> = tokens.iter().map(Token::source).collect();
+            assert_eq!(
+                (got, l),
+                (want.iter().map(|s| s.to_string()).collect(), len)
+            );
+        }
+        // A group is not closed by the next line.
+        for text in ["@a [x\ny]", "@a 'q\nq'"] {
+            let mut d = Diags::default();
+            let mut tokens = Vec::new();
+            let (range, l) = tokenize(text, 1, &mut d, &mut tokens);
+            assert_eq!((range, l, tokens.len()), (None, 5, 0), "{text:?}");
+        }
     }
 
     #[test]
@@ -394,6 +530,39 @@ mod tests {
             ["a1e", "3", ".5e+2", "[1 + 2]", "'q r'"]
         );
         assert_eq!(toks("x[y]z"), ["x", "[y]", "z"]);
+    }
+
+    #[test]
+    fn the_word_scan_equals_the_byte_scan() {
+        // Every byte value at every offset of a window, among bare bytes, and pseudo-random
+        // texts of the characters tokens are made of.
+        for b in 0..=255u8 {
+            for at in 0..20 {
+                let mut bytes = vec![b'a'; 24];
+                bytes[at] = b;
+                assert_eq!(
+                    bare_ascii_run(&bytes),
+                    bare_ascii_run_scalar(&bytes),
+                    "{b:#x} at {at}"
+                );
+            }
+        }
+        let alphabet = b"ab_9.-@e+ \t#[]'()*!\x0b\x1f\x80\xff";
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        for len in 0..200 {
+            let bytes: Vec<u8> = (0..len)
+                .map(|_| {
+                    seed ^= seed << 13;
+                    seed ^= seed >> 7;
+                    seed ^= seed << 17;
+                    alphabet[(seed % alphabet.len() as u64) as usize]
+                })
+                .collect();
+            for start in 0..bytes.len() {
+                let s = &bytes[start..];
+                assert_eq!(bare_ascii_run(s), bare_ascii_run_scalar(s), "{s:?}");
+            }
+        }
     }
 
     #[test]

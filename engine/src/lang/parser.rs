@@ -16,7 +16,7 @@
 
 use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::generate::{self, GenRequest};
-use super::lexer::{split_lines, Token};
+use super::lexer::Token;
 use super::symbols::Symbols;
 use super::Parsed;
 use crate::spec::{ModelSpec, SampleRateMode};
@@ -131,7 +131,7 @@ impl Position {
 
 fn parse_with(text: &str, mut diags: Diags) -> Parsed {
     // The tokens borrow the script's text.
-    let (mut items, tokens) = lines::read_items(split_lines(text), &mut diags);
+    let (mut items, tokens) = lines::read_items(text, &mut diags);
     let symbols = labels::declare_labels(&mut items, &tokens, &mut diags);
 
     // Pass 2: directives and commands in script order.

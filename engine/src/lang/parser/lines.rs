@@ -3,27 +3,29 @@
 use super::keywords::shape_of;
 use crate::lang::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use crate::lang::generate::{self, GenRequest};
-use crate::lang::lexer::{is_blank, tokenize, width, TokKind, Token};
+use crate::lang::lexer::{is_blank, line_len, tokenize, width, Lines, TokKind, Token};
 
-/// Reads the script's lines (`(line number, text)`) into items: command and
-/// directive lines tokenised, comments and blank lines skipped, other lines ignored with a
-/// warning when they look like a command. The tokens of every item are in one vector (one
-/// allocation for the script, not one per line).
-pub(super) fn read_items<'a>(
-    lines: Vec<(u32, &'a str)>,
-    diags: &mut Diags,
-) -> (Vec<Item>, Vec<Token<'a>>) {
-    let mut items = Vec::with_capacity(lines.len());
-    // A command has a label, a keyword and a few arguments.
-    let mut tokens = Vec::with_capacity(lines.len() * 6);
-    for (line, text) in lines {
-        let Some((first, lead)) = text.char_indices().find(|(_, c)| !is_blank(*c)) else {
-            continue;
-        };
-        match lead {
-            '@' | '~' => {
+/// Reads the script's lines (spec §3.2) into items: command and directive lines tokenised,
+/// comments and blank lines skipped, other lines ignored with a warning when they look like a
+/// command. The script's bytes are scanned once: a command line is lexed from its start to its
+/// break. The tokens of every item are in one vector (one allocation for the script, not one
+/// per line).
+pub(super) fn read_items<'a>(text: &'a str, diags: &mut Diags) -> (Vec<Item>, Vec<Token<'a>>) {
+    // A line is a few dozen bytes; a command has a label, a keyword and a few arguments.
+    let breaks = memchr::memchr_iter(b'\n', text.as_bytes()).count() + 1;
+    let mut items = Vec::with_capacity(breaks);
+    let mut tokens = Vec::with_capacity(breaks * 6);
+    let mut lines = Lines::new(text);
+    while let Some(rest) = lines.rest() {
+        let line = lines.number();
+        let lead = rest
+            .char_indices()
+            .find(|&(_, c)| !is_blank(c) || c == '\n' || c == '\r');
+        let len = match lead {
+            Some((first, lead @ ('@' | '~'))) => {
                 let directive = lead == '~';
-                match tokenize(text, line, diags, &mut tokens) {
+                let (range, len) = tokenize(rest, line, diags, &mut tokens);
+                match range {
                     Some(range) => items.push(Item {
                         line,
                         directive,
@@ -32,60 +34,83 @@ pub(super) fn read_items<'a>(
                         generator: None,
                         broken_generator: None,
                     }),
-                    None if !directive => {
-                        // Keep the label known so references to it do not cascade: the line
-                        // takes part in pass 1 with its label only (kind unknown).
-                        let rest = text.get(first..).unwrap_or("");
-                        let len = rest
-                            .find(|c: char| {
-                                is_blank(c) || matches!(c, '+' | '[' | ']' | '\'' | '#')
-                            })
-                            .unwrap_or(rest.len());
-                        let label = rest.get(..len).unwrap_or("");
-                        let col = col_of(text.get(..first).unwrap_or(""));
-                        tokens.push(Token {
-                            kind: TokKind::Bare,
-                            text: label,
-                            col,
-                            inner_col: col,
-                        });
-                        items.push(Item {
-                            line,
-                            directive: false,
-                            broken: true,
-                            tokens: tokens.len() - 1..tokens.len(),
-                            generator: None,
-                            broken_generator: None,
-                        });
-                    }
-                    None => {
-                        // A `~generate` line with a lexical error: its labels are unknown, so
-                        // references to them must not cascade.
-                        let words: Vec<&str> = text
-                            .get(first..)
-                            .unwrap_or("")
-                            .split(is_blank)
-                            .filter(|w| !w.is_empty())
-                            .take(3)
-                            .collect();
-                        if let Some(name) = generate::broken_name(&words) {
-                            items.push(Item {
-                                line,
-                                directive: true,
-                                broken: true,
-                                tokens: 0..0,
-                                generator: None,
-                                broken_generator: Some(name),
-                            });
-                        }
-                    }
+                    None => broken_line(
+                        rest.get(..len).unwrap_or(""),
+                        first,
+                        line,
+                        directive,
+                        &mut items,
+                        &mut tokens,
+                    ),
                 }
+                len
             }
-            '#' => {}
-            _ => check_ignored_line(text, line, diags),
-        }
+            Some((first, '#')) => line_len(rest, first),
+            Some((first, '\n' | '\r')) => first,
+            Some((first, _)) => {
+                let len = line_len(rest, first);
+                check_ignored_line(rest.get(..len).unwrap_or(""), line, diags);
+                len
+            }
+            None => rest.len(),
+        };
+        lines.advance(len);
     }
     (items, tokens)
+}
+
+/// A command or directive line with a lexical error (reported): a command keeps its label
+/// known so that references to it do not cascade (the line takes part in pass 1 with its label
+/// only, kind unknown); a `~generate` directive's labels are unknown, so references to them
+/// must not cascade either.
+fn broken_line<'a>(
+    text: &'a str,
+    first: usize,
+    line: u32,
+    directive: bool,
+    items: &mut Vec<Item>,
+    tokens: &mut Vec<Token<'a>>,
+) {
+    if !directive {
+        let rest = text.get(first..).unwrap_or("");
+        let len = rest
+            .find(|c: char| is_blank(c) || matches!(c, '+' | '[' | ']' | '\'' | '#'))
+            .unwrap_or(rest.len());
+        let label = rest.get(..len).unwrap_or("");
+        let col = col_of(text.get(..first).unwrap_or(""));
+        tokens.push(Token {
+            kind: TokKind::Bare,
+            text: label,
+            col,
+            inner_col: col,
+        });
+        items.push(Item {
+            line,
+            directive: false,
+            broken: true,
+            tokens: tokens.len() - 1..tokens.len(),
+            generator: None,
+            broken_generator: None,
+        });
+        return;
+    }
+    let words: Vec<&str> = text
+        .get(first..)
+        .unwrap_or("")
+        .split(is_blank)
+        .filter(|w| !w.is_empty())
+        .take(3)
+        .collect();
+    if let Some(name) = generate::broken_name(&words) {
+        items.push(Item {
+            line,
+            directive: true,
+            broken: true,
+            tokens: 0..0,
+            generator: None,
+            broken_generator: Some(name),
+        });
+    }
 }
 
 /// The column of the character after `before`.
