@@ -59,23 +59,26 @@ pub(crate) struct ControlArgs {
     num_dirty: usize,
     is_dirty: Vec<bool>,
     proxies_changed: bool,
-    /// No refresh has run yet.
+    /// No refresh has run yet: `raw` holds the values at `seen_params`, `args` nothing yet.
     fresh: bool,
 }
 
 impl ControlArgs {
     /// Indexes `bindings` once, when the model is compiled: which parameters each reads, its
     /// class, and the single mass (`single_cols`: the four argument columns of `singles`
-    /// masses) or connection point (`proxy_slots`) that derives from its slot.
+    /// masses) or connection point (`proxy_slots`) that derives from its slot. Each binding's
+    /// value at the parameters' values `params` is evaluated here, once: the first refresh
+    /// uses it when the parameters have not moved since.
     pub fn new(
         bindings: Vec<Binding>,
         program: &Program,
-        num_params: usize,
+        params: &[f64],
         args: &[f64],
         single_cols: [usize; 4],
         singles: usize,
         proxy_slots: impl Iterator<Item = usize>,
     ) -> ControlArgs {
+        let num_params = params.len();
         let mut count = vec![0u32; num_params + 1];
         let mut rescale: [Vec<u32>; NUM_ARG_CLASSES] = Default::default();
         let mut rescale_derived: [Vec<u32>; NUM_ARG_CLASSES] = Default::default();
@@ -104,13 +107,19 @@ impl ControlArgs {
                 .map(|(_, p)| p)
         };
         let mut stack = program.new_stack().0;
+        // Slots no binding writes keep the compiler's value.
+        let mut raw = args.to_vec();
         for (i, b) in bindings.iter().enumerate() {
             let mut reads_none = true;
             for p in params_of(b.expr) {
                 count[p as usize + 1] += 1;
                 reads_none = false;
             }
-            let constant_zero = reads_none && program.eval(b.expr, &[], &mut stack) == 0.0;
+            let value = program.eval(b.expr, params, &mut stack);
+            if let Some(r) = raw.get_mut(b.slot as usize) {
+                *r = value;
+            }
+            let constant_zero = reads_none && value == 0.0;
             if !constant_zero {
                 let c = b.class as usize;
                 match slot_dep[b.slot as usize] {
@@ -142,15 +151,14 @@ impl ControlArgs {
             "one binding per slot"
         );
         ControlArgs {
-            // Slots no binding writes keep the compiler's value.
-            raw: args.to_vec(),
+            raw,
             bindings,
             reader_start,
             readers,
             rescale,
             rescale_derived,
             slot_dep,
-            seen_params: vec![0.0; num_params],
+            seen_params: params.to_vec(),
             seen_factors: [0.0; NUM_ARG_CLASSES],
             dirty: vec![0; singles],
             num_dirty: 0,
@@ -204,9 +212,17 @@ impl ControlArgs {
         self.num_dirty = 0;
         self.proxies_changed = false;
         if self.fresh {
+            // `raw` holds every binding's value at `seen_params` (see `new`).
+            let moved = params.len() != self.seen_params.len()
+                || params
+                    .iter()
+                    .zip(&self.seen_params)
+                    .any(|(p, q)| p.to_bits() != q.to_bits());
             for b in &self.bindings {
                 let slot = b.slot as usize;
-                self.raw[slot] = program.eval(b.expr, params, stack);
+                if moved {
+                    self.raw[slot] = program.eval(b.expr, params, stack);
+                }
                 args[slot] = self.raw[slot] * factors[b.class as usize];
             }
             self.seen_params.copy_from_slice(params);

@@ -87,7 +87,7 @@ impl<'a> Cx<'a> {
         let control = ControlArgs::new(
             self.control_bindings,
             &self.program,
-            params.values.len(),
+            &params.values,
             &self.args,
             singles.cols,
             singles.len(),
