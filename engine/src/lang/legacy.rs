@@ -229,7 +229,6 @@ fn macro_velocity<'a>(
         kind: TokKind::Bare,
         text: "0",
         col: pos.col,
-        inner_col: pos.col,
     });
     Some(Read {
         args: out,
@@ -286,7 +285,6 @@ fn split_at_colon<'a>(t: &Token<'a>, at: usize) -> Option<(Token<'a>, Token<'a>)
         kind: TokKind::Bare,
         text,
         col: col_plus(t.col, by),
-        inner_col: col_plus(t.inner_col, by),
     };
     Some((part(u, 0), part(w, width(u).saturating_add(1))))
 }

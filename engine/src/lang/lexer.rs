@@ -81,11 +81,17 @@ pub(crate) struct Token<'a> {
     pub text: &'a str,
     /// Column of the token's first character (the `[` or `'` for groups).
     pub col: u32,
-    /// Column of the content's first character.
-    pub inner_col: u32,
 }
 
 impl<'a> Token<'a> {
+    /// Column of the content's first character: after the `[` or `'` of a group.
+    pub(crate) fn inner_col(&self) -> u32 {
+        match self.kind {
+            TokKind::Bare => self.col,
+            TokKind::Bracket | TokKind::Quoted => col_plus(self.col, 1),
+        }
+    }
+
     pub(crate) fn string(&self) -> String {
         self.text.to_string()
     }
@@ -404,7 +410,6 @@ fn lex_line<'a>(
                     kind: TokKind::Bare,
                     text: text.get(start..i).unwrap_or(""),
                     col: start_col,
-                    inner_col: start_col,
                 });
             }
         }
@@ -419,7 +424,6 @@ fn push_group<'a>(tokens: &mut Vec<Token<'a>>, kind: TokKind, content: &'a str, 
         kind,
         text: content,
         col,
-        inner_col: col_plus(col, 1),
     });
     col_plus(col, width(content).saturating_add(2))
 }

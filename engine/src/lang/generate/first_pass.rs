@@ -141,7 +141,7 @@ pub(crate) fn read(tokens: &[Token], line: u32, diags: &mut Diags, budget: &mut 
             {
                 value = Val {
                     value: g.string(),
-                    col: g.inner_col,
+                    col: g.inner_col(),
                     bracket: g.kind == TokKind::Bracket,
                 };
                 i += 1;

@@ -120,7 +120,7 @@ impl Builder<'_> {
         let items = split_items(t.text);
         let &(first, offset) = items.first()?;
         let target = label(after_first(first));
-        let target_col = col_plus(t.inner_col, offset);
+        let target_col = col_plus(t.inner_col(), offset);
         if target.is_empty() || target.contains(['(', ')']) {
             self.diags.push(
                 at.diag(

@@ -82,7 +82,6 @@ fn broken_line<'a>(
             kind: TokKind::Bare,
             text: label,
             col,
-            inner_col: col,
         });
         items.push(Item {
             line,

@@ -58,7 +58,7 @@ impl Builder<'_> {
             line: at.line,
             label: at.label,
         };
-        parse_expression(t.text, t.inner_col, &cx, &mut self.diags)
+        parse_expression(t.text, t.inner_col(), &cx, &mut self.diags)
     }
 
     /// An expression in an item of a vector or connection bracket.
@@ -73,7 +73,7 @@ impl Builder<'_> {
             line: at.line,
             label: at.label,
         };
-        parse_expression(text, col_plus(t.inner_col, offset), &cx, &mut self.diags)
+        parse_expression(text, col_plus(t.inner_col(), offset), &cx, &mut self.diags)
     }
 
     /// A position or velocity (spec §3.7): a scalar z, or a bracket `[x y z]` whose items are
