@@ -32,7 +32,7 @@ impl Builder<'_> {
         }
         let at = At {
             line: item.line,
-            label: Some(&label),
+            label: Some(label),
         };
         let span = Span::new(item.line, first.col);
         let Some(kw) = tokens.get(1) else {
@@ -88,7 +88,7 @@ impl Builder<'_> {
         };
         let place = legacy::Place {
             line: item.line,
-            label: &label,
+            label,
         };
         let read = legacy::read(form, (min, max), args, self.symbols, place, &mut self.diags);
         let (args, points) = match &read {
@@ -101,12 +101,12 @@ impl Builder<'_> {
         }
         let kind = match shape {
             Shape::Param | Shape::AudioParam => {
-                if let Some(p) = self.param(shape, &label, first, args, at, span) {
+                if let Some(p) = self.param(shape, label, first, args, at, span) {
                     self.spec.params.push(p);
                 }
                 return;
             }
-            _ => self.element(shape, &label, first, args, points, at),
+            _ => self.element(shape, label, first, args, points, at),
         };
         let Some(kind) = kind else {
             return;
