@@ -102,7 +102,7 @@ fn proxy_form<'a>(
             let t = args.get(slot)?;
             let name = bare_label(t)?;
             match symbols.declared(&name)?.kind {
-                SymKind::Macro { dims } => Some((slot, name, dims)),
+                SymKind::Macro { dims } => Some((slot, name, usize::from(dims))),
                 _ => None,
             }
         })

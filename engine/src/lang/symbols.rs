@@ -13,9 +13,10 @@ pub(crate) enum SymKind {
     Param,
     /// A mass-type element or an avatar: a valid endpoint.
     Point,
-    /// A macro addressed with `dims` connection coordinates.
+    /// A macro addressed with `dims` connection coordinates (1 or 2; a byte keeps the symbol
+    /// table's buckets small).
     Macro {
-        dims: usize,
+        dims: u8,
     },
     Interaction,
     FrcInput,

@@ -147,7 +147,7 @@ impl Builder<'_> {
                 );
                 ok = false;
             }
-            Some(SymKind::Macro { dims }) if dims != found => {
+            Some(SymKind::Macro { dims }) if usize::from(dims) != found => {
                 let what = if dims == 2 {
                     "a mesh takes 2 coordinates [@mesh u w]"
                 } else {
@@ -203,7 +203,7 @@ impl Builder<'_> {
         // are usually pieces of a spaced expression, already explained by the message above.
         let dims_mismatch = matches!(
             self.symbols.get(&target).map(|s| s.kind),
-            Some(SymKind::Macro { dims }) if dims != found
+            Some(SymKind::Macro { dims }) if usize::from(dims) != found
         );
         let count_ok = (found == 1 || found == 2) && !dims_mismatch;
         if !count_ok {
