@@ -169,61 +169,13 @@ const BARE_ASCII: [bool; 256] = {
     table
 };
 
-/// The length of the run of bare ASCII bytes at the start of `bytes`: the scalar reference of
-/// [`bare_ascii_run`].
+/// The length of the run of bare ASCII bytes at the start of `bytes`.
 #[inline]
-fn bare_ascii_run_scalar(bytes: &[u8]) -> usize {
+fn bare_ascii_run(bytes: &[u8]) -> usize {
     bytes
         .iter()
         .position(|&b| !BARE_ASCII[usize::from(b)])
         .unwrap_or(bytes.len())
-}
-
-/// Each byte of `w` repeated: `0x0101…01 × b`.
-const fn splat(b: u8) -> u64 {
-    0x0101_0101_0101_0101 * b as u64
-}
-
-const HIGH: u64 = splat(0x80);
-
-/// The high bit of every byte of `w` below `n` (`n` ≤ 0x80), and maybe of bytes above such a
-/// byte (a borrow): the lowest flagged byte is exact.
-#[inline]
-fn bytes_below(w: u64, n: u8) -> u64 {
-    w.wrapping_sub(splat(n)) & !w & HIGH
-}
-
-/// The high bit of every byte of `w` equal to `b`; the lowest flagged byte is exact.
-#[inline]
-fn bytes_equal(w: u64, b: u8) -> u64 {
-    bytes_below(w ^ splat(b), 1)
-}
-
-/// The length of the run of bare ASCII bytes at the start of `bytes`, eight bytes at a time:
-/// where the scalar loop's exit, taken once a token at an unpredictable length, costs a
-/// mispredicted branch, a word finds the first byte that may end the token without a branch.
-/// That is a byte below `+` (0x2b: blanks, `#`, `'` and a few bare punctuation marks), `+`,
-/// `[`, `]` or a non-ASCII byte; the few bare bytes among them (`!`, `(`, `*`, …) go on.
-/// Equal to [`bare_ascii_run_scalar`] (test `the_word_scan_equals_the_byte_scan`).
-#[inline]
-fn bare_ascii_run(bytes: &[u8]) -> usize {
-    let mut n = 0;
-    while let Some(chunk) = bytes.get(n..n + 8) {
-        let mut word = [0u8; 8];
-        word.copy_from_slice(chunk);
-        let w = u64::from_le_bytes(word);
-        let maybe = bytes_below(w, 0x2c) | (w & HIGH) | bytes_equal(w, b'[') | bytes_equal(w, b']');
-        if maybe == 0 {
-            n += 8;
-            continue;
-        }
-        let at = n + (maybe.trailing_zeros() / 8) as usize;
-        match bytes.get(at) {
-            Some(&b) if BARE_ASCII[usize::from(b)] => n = at + 1,
-            _ => return at,
-        }
-    }
-    n + bare_ascii_run_scalar(bytes.get(n..).unwrap_or(&[]))
 }
 
 /// True when `tok` (the bare token scanned so far) ends with the mantissa of a number followed
@@ -378,13 +330,11 @@ fn lex_line<'a>(
                 i = j + 1;
             }
             _ => {
-                if !b.is_ascii() {
-                    let c = text.get(i..).and_then(|s| s.chars().next()).unwrap_or(' ');
-                    if is_blank(c) {
-                        i += c.len_utf8().max(1);
-                        col = col_plus(col, 1);
-                        continue;
-                    }
+                if let Some((_, len)) = char_at(text, i).filter(|&(c, _)| is_blank(c)) {
+                    // A non-ASCII blank (the ASCII ones are matched above).
+                    i += len;
+                    col = col_plus(col, 1);
+                    continue;
                 }
                 let (start, start_col) = (i, col);
                 loop {
@@ -534,39 +484,6 @@ mod tests {
             ["a1e", "3", ".5e+2", "[1 + 2]", "'q r'"]
         );
         assert_eq!(toks("x[y]z"), ["x", "[y]", "z"]);
-    }
-
-    #[test]
-    fn the_word_scan_equals_the_byte_scan() {
-        // Every byte value at every offset of a window, among bare bytes, and pseudo-random
-        // texts of the characters tokens are made of.
-        for b in 0..=255u8 {
-            for at in 0..20 {
-                let mut bytes = vec![b'a'; 24];
-                bytes[at] = b;
-                assert_eq!(
-                    bare_ascii_run(&bytes),
-                    bare_ascii_run_scalar(&bytes),
-                    "{b:#x} at {at}"
-                );
-            }
-        }
-        let alphabet = b"ab_9.-@e+ \t#[]'()*!\x0b\x1f\x80\xff";
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        for len in 0..200 {
-            let bytes: Vec<u8> = (0..len)
-                .map(|_| {
-                    seed ^= seed << 13;
-                    seed ^= seed >> 7;
-                    seed ^= seed << 17;
-                    alphabet[(seed % alphabet.len() as u64) as usize]
-                })
-                .collect();
-            for start in 0..bytes.len() {
-                let s = &bytes[start..];
-                assert_eq!(bare_ascii_run(s), bare_ascii_run_scalar(s), "{s:?}");
-            }
-        }
     }
 
     #[test]
