@@ -142,24 +142,30 @@ pub enum Expr {
     /// A numeric literal.
     Num(f64),
     /// A reference to a `param` or `audioParam`.
-    Name(String),
+    Name(Box<str>),
     /// Unary minus.
     Neg(Box<Expr>),
     /// A binary operation.
     Binary(BinOp, Box<Expr>, Box<Expr>),
     /// A function call; the argument count is checked by the parser and the compiler.
-    Call(Func, Vec<Expr>),
+    Call(Func, Box<[Expr]>),
 }
+
+// A spec holds an expression for every argument of every element: names and call arguments
+// are boxed slices, not growable vectors, so that an expression is three words (a script
+// written element by element builds and copies thousands of them).
+#[cfg(target_pointer_width = "64")]
+const _: () = assert!(std::mem::size_of::<Expr>() == 24);
 
 impl Expr {
     /// A reference to the parameter `name`.
     pub fn param(name: &str) -> Expr {
-        Expr::Name(name.to_string())
+        Expr::Name(name.into())
     }
 
     /// A call of `func` on `args`.
     pub fn call(func: Func, args: Vec<Expr>) -> Expr {
-        Expr::Call(func, args)
+        Expr::Call(func, args.into_boxed_slice())
     }
 
     /// The literal value, if this is a plain (possibly negated) number.
@@ -390,7 +396,7 @@ impl Program {
         };
         match expr {
             Expr::Num(v) => push_one(Op::Const(*v), depth),
-            Expr::Name(n) => push_one(Op::Param(resolve(n).ok_or(n.as_str())?), depth),
+            Expr::Name(n) => push_one(Op::Param(resolve(n).ok_or(&**n)?), depth),
             Expr::Neg(e) => {
                 self.emit(e, resolve, depth, max_depth)?;
                 self.ops.push(Op::Neg);

@@ -722,7 +722,7 @@ fn emit(b: &mut ModelBuilder, g: &Generator, nodes: &[Node], out: &Generated, nu
         b.param(param, value);
     }
     for (node, label) in nodes.iter().zip(&out.nodes) {
-        let pos = Vector::Xyz(node.pos.map(Expr::Num));
+        let pos = Vector::Xyz(Box::new(node.pos.map(Expr::Num)));
         if node.fixed {
             b.ground(label, pos);
         } else if g.zo == 0.0 {

@@ -93,7 +93,9 @@ pub enum ParamKind {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Vector {
     Scalar(Expr),
-    Xyz([Expr; 3]),
+    /// Boxed: most positions are scalars; inline, three expressions would set the size of
+    /// every mass in a spec.
+    Xyz(Box<[Expr; 3]>),
 }
 
 impl Vector {
@@ -101,7 +103,7 @@ impl Vector {
     pub fn z(&self) -> &Expr {
         match self {
             Vector::Scalar(z) => z,
-            Vector::Xyz([_, _, z]) => z,
+            Vector::Xyz(v) => &v[2],
         }
     }
 
@@ -109,7 +111,7 @@ impl Vector {
     pub fn xy(&self) -> Option<(&Expr, &Expr)> {
         match self {
             Vector::Scalar(_) => None,
-            Vector::Xyz([x, y, _]) => Some((x, y)),
+            Vector::Xyz(v) => Some((&v[0], &v[1])),
         }
     }
 }
@@ -128,7 +130,7 @@ impl From<Expr> for Vector {
 
 impl From<[f64; 3]> for Vector {
     fn from(v: [f64; 3]) -> Self {
-        Vector::Xyz(v.map(Expr::Num))
+        Vector::Xyz(Box::new(v.map(Expr::Num)))
     }
 }
 
@@ -138,9 +140,16 @@ pub enum Endpoint {
     /// `@label`: a mass-type element or an avatar (and, for outputs, a ground).
     Label(Label),
     /// `[@macro α]` on a string, chain or stiff string: α ∈ [0, 1] along the nodes.
-    Line { target: Label, alpha: Expr },
+    Line { target: Label, alpha: Box<Expr> },
     /// `[@mesh u w]` on a mesh: u along the length, w along the width.
-    Surface { target: Label, u: Expr, w: Expr },
+    ///
+    /// The coordinates of both forms are boxed: nearly every endpoint is a plain label, and
+    /// every interaction in a spec holds two endpoints.
+    Surface {
+        target: Label,
+        u: Box<Expr>,
+        w: Box<Expr>,
+    },
 }
 
 impl Endpoint {
@@ -153,7 +162,7 @@ impl Endpoint {
     pub fn at(target: &str, alpha: impl Into<Expr>) -> Endpoint {
         Endpoint::Line {
             target: target.into(),
-            alpha: alpha.into(),
+            alpha: Box::new(alpha.into()),
         }
     }
 
@@ -161,8 +170,8 @@ impl Endpoint {
     pub fn at2(target: &str, u: impl Into<Expr>, w: impl Into<Expr>) -> Endpoint {
         Endpoint::Surface {
             target: target.into(),
-            u: u.into(),
-            w: w.into(),
+            u: Box::new(u.into()),
+            w: Box::new(w.into()),
         }
     }
 
@@ -391,8 +400,9 @@ pub enum ElementKind {
         pos: Vector,
         delayed: Vector,
     },
-    /// A macro structure (spec §2.7).
-    Macro(MacroSpec),
+    /// A macro structure (spec §2.7). Boxed: a macro is one element of a model and its spec is
+    /// the largest kind, which would otherwise set the size of every element.
+    Macro(Box<MacroSpec>),
     /// An interaction between two endpoints (spec §2.3–§2.6).
     Interaction { law: Law, a: Endpoint, b: Endpoint },
     /// `@inN posInput pos`: an avatar (spec §2.2.1).

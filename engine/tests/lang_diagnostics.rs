@@ -889,11 +889,11 @@ fn vectors_and_connection_expressions() {
     };
     assert_eq!(
         pos,
-        &Vector::Xyz([
+        &Vector::Xyz(Box::new([
             Expr::param("K") + Expr::Num(1.0),
             Expr::Num(-2.0),
             Expr::param("K") * Expr::Num(3.0)
-        ])
+        ]))
     );
     let ElementKind::Interaction { a, b, .. } = &spec.elements[2].kind else {
         panic!()

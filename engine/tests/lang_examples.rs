@@ -308,7 +308,7 @@ fn values_and_shapes() {
     else {
         panic!()
     };
-    assert_eq!(alpha, Expr::param("bowPos") - Expr::Num(0.06));
+    assert_eq!(*alpha, Expr::param("bowPos") - Expr::Num(0.06));
     let ElementKind::Macro(m) = kind("me1") else {
         panic!()
     };

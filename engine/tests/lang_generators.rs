@@ -43,7 +43,7 @@ impl Graph {
             stiff: Vec::new(),
         };
         let xyz = |v: &Vector| match v {
-            Vector::Xyz(c) => c.clone().map(|e| e.as_number().unwrap()),
+            Vector::Xyz(c) => (**c).clone().map(|e| e.as_number().unwrap()),
             Vector::Scalar(z) => [0.0, 0.0, z.as_number().unwrap()],
         };
         let mut index = HashMap::new();

@@ -24,7 +24,7 @@ fn expr(names: Vec<String>) -> BoxedStrategy<Expr> {
     } else {
         prop_oneof![
             num().prop_map(Expr::Num),
-            select(names).prop_map(Expr::Name)
+            select(names).prop_map(|n| Expr::Name(n.into()))
         ]
         .boxed()
     };
@@ -43,7 +43,7 @@ fn expr(names: Vec<String>) -> BoxedStrategy<Expr> {
             )
                 .prop_map(|(f, mut args)| {
                     args.truncate(f.arity());
-                    Expr::Call(f, args)
+                    Expr::Call(f, args.into())
                 }),
         ]
     })
@@ -54,7 +54,7 @@ fn vector(names: Vec<String>) -> BoxedStrategy<Vector> {
     prop_oneof![
         expr(names.clone()).prop_map(Vector::Scalar),
         (expr(names.clone()), expr(names.clone()), expr(names))
-            .prop_map(|(x, y, z)| Vector::Xyz([x, y, z])),
+            .prop_map(|(x, y, z)| Vector::Xyz(Box::new([x, y, z]))),
     ]
     .boxed()
 }
@@ -106,7 +106,7 @@ fn point(names: Vec<String>) -> BoxedStrategy<ElementKind> {
             v()
         )
             .prop_map(|(kind, length, width, m, k, k2, z, zo, pos, vel)| {
-                ElementKind::Macro(MacroSpec {
+                ElementKind::Macro(Box::new(MacroSpec {
                     kind,
                     length,
                     width: if kind.is_2d() { width } else { 1 },
@@ -117,7 +117,7 @@ fn point(names: Vec<String>) -> BoxedStrategy<ElementKind> {
                     zo,
                     pos,
                     vel,
-                })
+                }))
             }),
         v().prop_map(|pos| ElementKind::PosInput { channel: 0, pos }),
     ]
@@ -138,13 +138,13 @@ fn endpoint(
         if is_2d {
             Endpoint::Surface {
                 target: target.into(),
-                u,
-                w,
+                u: Box::new(u),
+                w: Box::new(w),
             }
         } else {
             Endpoint::Line {
                 target: target.into(),
-                alpha: u,
+                alpha: Box::new(u),
             }
         }
     });

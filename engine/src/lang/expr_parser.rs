@@ -351,7 +351,7 @@ impl ExprParser<'_, '_> {
                     self.call(name, col)
                 } else {
                     self.name(&name, col);
-                    Some((Expr::Name(name), 1))
+                    Some((Expr::Name(name.into()), 1))
                 }
             }
             _ => {
@@ -479,7 +479,7 @@ impl ExprParser<'_, '_> {
                 .with_found(args.len().to_string()),
             );
         }
-        Some((Expr::Call(func, args), d))
+        Some((Expr::Call(func, args.into_boxed_slice()), d))
     }
 }
 

@@ -124,7 +124,10 @@ fn vector(v: &Vector) -> String {
                 t
             }
         }
-        Vector::Xyz([x, y, z]) => format!("[{} {} {}]", item(x), item(y), item(z)),
+        Vector::Xyz(v) => {
+            let [x, y, z] = &**v;
+            format!("[{} {} {}]", item(x), item(y), item(z))
+        }
     }
 }
 

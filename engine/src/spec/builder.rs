@@ -166,7 +166,7 @@ impl ModelBuilder {
     ) -> &mut Self {
         self.element(
             label,
-            ElementKind::Macro(MacroSpec {
+            ElementKind::Macro(Box::new(MacroSpec {
                 kind,
                 length: nodes,
                 width: 1,
@@ -177,7 +177,7 @@ impl ModelBuilder {
                 zo: Expr::Num(0.0),
                 pos: 0.0.into(),
                 vel: 0.0.into(),
-            }),
+            })),
         )
     }
 
@@ -194,7 +194,7 @@ impl ModelBuilder {
     ) -> &mut Self {
         self.element(
             label,
-            ElementKind::Macro(MacroSpec {
+            ElementKind::Macro(Box::new(MacroSpec {
                 kind,
                 length,
                 width,
@@ -205,13 +205,13 @@ impl ModelBuilder {
                 zo: Expr::Num(0.0),
                 pos: 0.0.into(),
                 vel: 0.0.into(),
-            }),
+            })),
         )
     }
 
     /// Any macro, fully specified.
     pub fn macro_spec(&mut self, label: &str, spec: MacroSpec) -> &mut Self {
-        self.element(label, ElementKind::Macro(spec))
+        self.element(label, ElementKind::Macro(Box::new(spec)))
     }
 
     /// An interaction `@label <law> a b args…`.

@@ -142,7 +142,7 @@ impl Builder<'_> {
                 let k2 = if nparams == 4 { Some(e.next()?) } else { None };
                 let z = e.next()?;
                 let zo = e.next().unwrap_or(Expr::Num(0.0));
-                Some(ElementKind::Macro(MacroSpec {
+                Some(ElementKind::Macro(Box::new(MacroSpec {
                     kind,
                     length: u32::try_from(length).ok()?,
                     width: u32::try_from(width).ok()?,
@@ -153,7 +153,7 @@ impl Builder<'_> {
                     zo,
                     pos,
                     vel,
-                }))
+                })))
             }
             Shape::PosInput => {
                 let channel = self.channel(label, "in", first, at);

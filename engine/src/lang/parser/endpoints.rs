@@ -106,12 +106,12 @@ impl Builder<'_> {
         match <[Option<Expr>; 2]>::try_from(coords) {
             Ok([u, w]) => Some(Endpoint::Surface {
                 target,
-                u: u?,
-                w: w?,
+                u: Box::new(u?),
+                w: Box::new(w?),
             }),
             Err(mut one) => Some(Endpoint::Line {
                 target,
-                alpha: one.pop()??,
+                alpha: Box::new(one.pop()??),
             }),
         }
     }
@@ -219,9 +219,16 @@ impl Builder<'_> {
             return None;
         }
         match <[Expr; 1]>::try_from(exprs) {
-            Ok([alpha]) => Some(Endpoint::Line { target, alpha }),
+            Ok([alpha]) => Some(Endpoint::Line {
+                target,
+                alpha: Box::new(alpha),
+            }),
             Err(exprs) => match <[Expr; 2]>::try_from(exprs) {
-                Ok([u, w]) => Some(Endpoint::Surface { target, u, w }),
+                Ok([u, w]) => Some(Endpoint::Surface {
+                    target,
+                    u: Box::new(u),
+                    w: Box::new(w),
+                }),
                 Err(_) => None,
             },
         }

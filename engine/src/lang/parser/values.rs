@@ -89,7 +89,7 @@ impl Builder<'_> {
                 let x = self.item_expr(t, *x, at);
                 let y = self.item_expr(t, *y, at);
                 let z = self.item_expr(t, *z, at);
-                Some(Vector::Xyz([x?, y?, z?]))
+                Some(Vector::Xyz(Box::new([x?, y?, z?])))
             }
             _ => {
                 self.diags.push(
