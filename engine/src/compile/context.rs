@@ -2,7 +2,7 @@
 //! checks and compilation, argument binding, and the resolution of an endpoint to a point.
 
 use super::errors::{CompileError, CompileErrorKind};
-use super::label_map::LabelMap;
+use super::label_map::{LabelKey, LabelMap};
 use super::MAX_EXPR_DEPTH;
 use crate::engine::{ArgClass, Binding, Proxies};
 use crate::expr::{Expr, ExprRef, Program};
@@ -54,7 +54,7 @@ impl Role {
 /// slots and expression program that binding fills.
 pub(super) struct Cx<'a> {
     pub spec: &'a ModelSpec,
-    pub symbols: LabelMap<&'a str, Symbol>,
+    pub symbols: LabelMap<LabelKey<'a>, Symbol>,
     pub errors: Vec<CompileError>,
     pub program: Program,
     pub args: Vec<f64>,
@@ -126,7 +126,7 @@ impl<'a> Cx<'a> {
         let mut names = Vec::new();
         expr.for_each_name(&mut |n| names.push(n.to_string()));
         for n in names {
-            match self.symbols.get(n.as_str()) {
+            match self.symbols.get(&LabelKey(&n)) {
                 Some(Symbol::Param(_)) => {}
                 Some(Symbol::Element(..)) => {
                     self.error(Some(element), CompileErrorKind::NotAParameter(n));
@@ -179,7 +179,7 @@ impl<'a> Cx<'a> {
         let nan = Expr::Num(f64::NAN);
         let expr = if valid { expr } else { &nan };
         let symbols = &self.symbols;
-        let resolve = |n: &str| match symbols.get(n) {
+        let resolve = |n: &str| match symbols.get(&LabelKey(n)) {
             Some(Symbol::Param(id)) => Some(*id),
             _ => None,
         };
@@ -189,7 +189,7 @@ impl<'a> Cx<'a> {
             .expect("names were checked");
         let mut audio = false;
         expr.for_each_name(&mut |n| {
-            if let Some(Symbol::Param(id)) = self.symbols.get(n) {
+            if let Some(Symbol::Param(id)) = self.symbols.get(&LabelKey(n)) {
                 audio |= self.param_is_audio[*id as usize];
             }
         });
@@ -243,7 +243,7 @@ impl<'a> Cx<'a> {
     /// is the index of the first connection point.
     pub fn endpoint(&mut self, ep: &'a Endpoint, element: usize, proxy_base: usize) -> Option<u32> {
         let target = ep.target();
-        let Some(&symbol) = self.symbols.get(target) else {
+        let Some(&symbol) = self.symbols.get(&LabelKey(target)) else {
             self.error(
                 Some(element),
                 CompileErrorKind::UndefinedElement(target.to_string()),
@@ -297,7 +297,7 @@ impl<'a> Cx<'a> {
                 let base = self.element_point[j]?;
                 for c in &coords {
                     c.for_each_name(&mut |n| {
-                        if let Some(Symbol::Param(id)) = self.symbols.get(n) {
+                        if let Some(Symbol::Param(id)) = self.symbols.get(&LabelKey(n)) {
                             self.param_is_coordinate[*id as usize] = true;
                         }
                     });

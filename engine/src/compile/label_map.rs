@@ -7,10 +7,53 @@
 //! for its own symbol tables) serves: a few cycles per eight bytes.
 
 use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
+use std::hash::{BuildHasherDefault, Hash, Hasher};
 
 /// A `HashMap` with [`LabelHasher`]. Iteration order is unspecified, as with std's.
 pub(crate) type LabelMap<K, V> = HashMap<K, V, BuildHasherDefault<LabelHasher>>;
+
+/// A label borrowed as a map key: hashed as a `str` is, and compared inline, with fixed-size
+/// loads, where a `str` key calls `memcmp`, whose dispatch on length costs more than comparing
+/// a label of a few bytes.
+#[derive(Clone, Copy, Debug, Eq)]
+pub(crate) struct LabelKey<'a>(pub(crate) &'a str);
+
+impl PartialEq for LabelKey<'_> {
+    #[inline]
+    fn eq(&self, other: &Self) -> bool {
+        same_bytes(self.0.as_bytes(), other.0.as_bytes())
+    }
+}
+
+impl Hash for LabelKey<'_> {
+    #[inline]
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        // As `str` hashes: the terminator's round also mixes a short key's high bits into the
+        // low ones, which pick the bucket.
+        self.0.hash(state);
+    }
+}
+
+/// `a == b`, for short slices without a call: equal lengths, then the words that cover every
+/// byte ([`tail_word`] up to 7 bytes, the first and last 8 up to 16).
+#[inline]
+fn same_bytes(a: &[u8], b: &[u8]) -> bool {
+    let n = a.len();
+    if n != b.len() {
+        return false;
+    }
+    let word = |s: &[u8], at: usize| {
+        s.get(at..at + 8)
+            .and_then(|w| <[u8; 8]>::try_from(w).ok())
+            .map(u64::from_le_bytes)
+    };
+    match n {
+        0 => true,
+        1..=7 => tail_word(a) == tail_word(b),
+        8..=16 => word(a, 0) == word(b, 0) && word(a, n - 8) == word(b, n - 8),
+        _ => a == b,
+    }
+}
 
 /// A multiplicative word-at-a-time hash for short keys (not collision-resistant).
 #[derive(Clone, Copy, Debug, Default)]
@@ -104,6 +147,30 @@ mod tests {
         m.insert("a", 1);
         m.insert("a\0", 2);
         assert_eq!((m.get("a"), m.get("a\0")), (Some(&1), Some(&2)));
+    }
+
+    #[test]
+    fn label_keys_compare_as_their_text() {
+        let texts: Vec<String> = (0..=20)
+            .flat_map(|n| {
+                let base: String = (0..n).map(|i| char::from(b'a' + (i % 26) as u8)).collect();
+                // The text, and the text with each byte changed in turn.
+                let changed = (0..n).map({
+                    let base = base.clone();
+                    move |i| {
+                        let mut b = base.clone().into_bytes();
+                        b[i] = b'#';
+                        String::from_utf8(b).unwrap()
+                    }
+                });
+                std::iter::once(base).chain(changed).collect::<Vec<_>>()
+            })
+            .collect();
+        for a in &texts {
+            for b in &texts {
+                assert_eq!(LabelKey(a) == LabelKey(b), a == b, "{a:?} {b:?}");
+            }
+        }
     }
 
     #[test]

@@ -4,6 +4,7 @@
 
 use super::context::{Cx, Role, Symbol};
 use super::errors::{CompileError, CompileErrorKind};
+use super::label_map::LabelKey;
 use crate::engine::Route;
 use crate::expr::Func;
 use crate::info::ParamInfo;
@@ -24,7 +25,7 @@ impl Cx<'_> {
         let spec = self.spec;
         // The first declaration of a label wins; a later one is reported with its span.
         for (id, p) in spec.params.iter().enumerate() {
-            match self.symbols.entry(p.name.as_str()) {
+            match self.symbols.entry(LabelKey(&p.name)) {
                 Entry::Occupied(first) => {
                     let first = symbol_span(self.spec, *first.get());
                     self.errors.push(CompileError {
@@ -47,7 +48,7 @@ impl Cx<'_> {
             }
         }
         for (i, e) in spec.elements.iter().enumerate() {
-            match self.symbols.entry(e.label.as_str()) {
+            match self.symbols.entry(LabelKey(&e.label)) {
                 Entry::Occupied(first) => {
                     let first = symbol_span(self.spec, *first.get());
                     self.error(Some(i), CompileErrorKind::DuplicateLabel { first });
