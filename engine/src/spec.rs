@@ -135,6 +135,9 @@ impl From<[f64; 3]> for Vector {
 }
 
 /// One endpoint of an interaction, or the target of an input or output (spec §1.4, §2.8).
+///
+/// The coordinates of the connection-point forms are boxed: nearly every endpoint is a plain
+/// label, and every interaction in a spec holds two endpoints.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Endpoint {
     /// `@label`: a mass-type element or an avatar (and, for outputs, a ground).
@@ -142,9 +145,6 @@ pub enum Endpoint {
     /// `[@macro α]` on a string, chain or stiff string: α ∈ [0, 1] along the nodes.
     Line { target: Label, alpha: Box<Expr> },
     /// `[@mesh u w]` on a mesh: u along the length, w along the width.
-    ///
-    /// The coordinates of both forms are boxed: nearly every endpoint is a plain label, and
-    /// every interaction in a spec holds two endpoints.
     Surface {
         target: Label,
         u: Box<Expr>,
