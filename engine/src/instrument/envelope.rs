@@ -171,8 +171,21 @@ pub fn exact_envelope(engine: &mut Engine) -> Option<StabilityEnvelope> {
     if ex.is_stable(1.0, 1.0) != Some(true) {
         return None;
     }
-    let z_max = ex.max_damping(0.0)?;
-    let k_max = ex.max_stiffness(0.0)?;
+    // Each limit is a bisection of some fifty sparse factorisations (a second for the largest
+    // plates): the two axes at once, the Damping one on a thread of its own.
+    let (z_max, k_max) = std::thread::scope(|s| {
+        let z = std::thread::Builder::new()
+            .name("ressort-limits".into())
+            .spawn_scoped(s, || ex.max_damping(0.0))
+            .ok();
+        let k_max = ex.max_stiffness(0.0);
+        let z_max = match z {
+            Some(h) => h.join().ok().flatten(),
+            None => ex.max_damping(0.0),
+        };
+        (z_max, k_max)
+    });
+    let (z_max, k_max) = (z_max?, k_max?);
     let mut lines = Vec::new();
     if !z_max.is_finite() {
         // Nothing scales with Damping: the Stiffness limit alone.
@@ -189,7 +202,12 @@ pub fn exact_envelope(engine: &mut Engine) -> Option<StabilityEnvelope> {
         let mut points: Vec<(f64, f64)> = Vec::with_capacity(EXACT_SAMPLES.len() + 1);
         for f in EXACT_SAMPLES {
             let z = f * z_max;
-            points.push((ex.max_stiffness(z)?, z));
+            let k = if z == 0.0 {
+                k_max
+            } else {
+                ex.max_stiffness(z)?
+            };
+            points.push((k, z));
         }
         points.push((0.0, z_max));
         for w in points.windows(2) {

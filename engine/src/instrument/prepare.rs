@@ -257,13 +257,12 @@ fn macro_units(
     macros: &[Option<MacroBinding>],
     note_input: Option<usize>,
 ) -> Vec<MacroUnit> {
-    let small = engine.info().num_points <= crate::modes::DENSE_LIMIT;
+    // The reference mode is measured by the dense analysis only, and needs an output.
+    let measurable =
+        engine.info().num_points <= crate::modes::DENSE_LIMIT && engine.info().num_outputs() > 0;
     let input = note_input.unwrap_or(0) + 1;
     let params = engine.info().params.clone();
-    let mut reference = |e: &mut Engine| -> Option<(f64, f64)> {
-        if !small || e.info().num_outputs() == 0 {
-            return None;
-        }
+    let reference = |e: &mut Engine| -> Option<(f64, f64)> {
         let a = e.modes(None);
         a.strongest(input, 1, 20.0)
             .map(|m| (m.frequency_hz, m.t60_s))
@@ -274,12 +273,12 @@ fn macro_units(
         .map(|b| match b {
             Some(b) => {
                 let p = &params[b.param.0 as usize];
-                if started.elapsed().as_secs_f64() > UNITS_BUDGET_S {
-                    // Out of time: positions still read as positions, the rest as values.
-                    let mut none = |_: &mut Engine| None;
-                    return unit_of(engine, b, p.coordinate, &mut none);
+                if !measurable || started.elapsed().as_secs_f64() > UNITS_BUDGET_S {
+                    // Nothing to measure, or out of time: positions still read as positions,
+                    // the rest as values.
+                    return unit_of(engine, b, p.coordinate, &|_: &mut Engine| None);
                 }
-                unit_of(engine, b, p.coordinate, &mut reference)
+                unit_of(engine, b, p.coordinate, &reference)
             }
             None => MacroUnit::Value,
         })

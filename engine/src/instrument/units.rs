@@ -129,49 +129,65 @@ const TABLE_POSITIONS: [f64; 3] = [0.0, 0.5, 1.0];
 
 /// The unit of slot `b`. `reference(engine)` measures the reference mode of the engine as it
 /// stands: (frequency in Hz, T60 in s), or None where the analysis does not apply; it is
-/// called at a few slot positions for a stiffness or damping. The engine is left at the
-/// declared value.
+/// called at the [`TABLE_POSITIONS`] for a stiffness or damping, all at once: each is a modal
+/// analysis of up to a few hundred milliseconds, so each but the first runs on its own thread
+/// with its own copy of the engine (a table whose low end fails then costs the other two in
+/// CPU time, not in wall time). The engine is left at the declared value.
 pub fn unit_of(
     engine: &mut Engine,
     b: &MacroBinding,
     coordinate: bool,
-    reference: &mut dyn FnMut(&mut Engine) -> Option<(f64, f64)>,
+    reference: &(dyn Fn(&mut Engine) -> Option<(f64, f64)> + Sync),
 ) -> MacroUnit {
     if coordinate {
         return MacroUnit::Position;
     }
     let role = role(engine, b);
-    let table = |engine: &mut Engine,
-                 pick: fn((f64, f64)) -> f64,
-                 reference: &mut dyn FnMut(&mut Engine) -> Option<(f64, f64)>|
-     -> Option<UnitTable> {
-        let mut points = Vec::with_capacity(TABLE_POSITIONS.len());
-        for n in TABLE_POSITIONS {
-            engine.set_param(b.param, b.value_at(n)).ok()?;
-            engine.apply_pending_changes();
-            let v = reference(engine).map(pick);
-            match v {
-                Some(v) if v.is_finite() && v > 0.0 => points.push((n, v)),
-                _ => {
-                    let _ = engine.set_param(b.param, b.default);
-                    engine.apply_pending_changes();
-                    return None;
-                }
+    let table = |engine: &mut Engine, pick: fn((f64, f64)) -> f64| -> Option<UnitTable> {
+        let measure = |e: &mut Engine, n: f64| -> Option<f64> {
+            e.set_param(b.param, b.value_at(n)).ok()?;
+            e.apply_pending_changes();
+            reference(e).map(pick)
+        };
+        // The positions at once: each but the first on its own thread, with its own copy of
+        // the engine. Where no thread can be had, a position is measured here.
+        let values: Vec<Option<f64>> = std::thread::scope(|s| {
+            let others: Vec<_> = TABLE_POSITIONS[1..]
+                .iter()
+                .map(|&n| {
+                    let mut copy = engine.clone();
+                    std::thread::Builder::new()
+                        .name("ressort-units".into())
+                        .spawn_scoped(s, move || measure(&mut copy, n))
+                        .ok()
+                })
+                .collect();
+            let mut values = vec![measure(engine, TABLE_POSITIONS[0])];
+            for (h, &n) in others.into_iter().zip(&TABLE_POSITIONS[1..]) {
+                values.push(match h {
+                    Some(h) => h.join().ok().flatten(),
+                    None => measure(engine, n),
+                });
             }
-        }
+            values
+        });
         let _ = engine.set_param(b.param, b.default);
         engine.apply_pending_changes();
+        let points = TABLE_POSITIONS
+            .iter()
+            .zip(values)
+            .map(|(&n, v)| match v {
+                Some(v) if v.is_finite() && v > 0.0 => Some((n, v)),
+                _ => None,
+            })
+            .collect::<Option<Vec<_>>>()?;
         let t = UnitTable { points };
         t.is_monotone().then_some(t)
     };
     match role {
         Role::Mass if b.default > 0.0 => MacroUnit::MassRatio,
-        Role::Stiffness => {
-            table(engine, |r| r.0, reference).map_or(MacroUnit::Value, MacroUnit::Frequency)
-        }
-        Role::Damping => {
-            table(engine, |r| r.1, reference).map_or(MacroUnit::Value, MacroUnit::Decay)
-        }
+        Role::Stiffness => table(engine, |r| r.0).map_or(MacroUnit::Value, MacroUnit::Frequency),
+        Role::Damping => table(engine, |r| r.1).map_or(MacroUnit::Value, MacroUnit::Decay),
         _ => MacroUnit::Value,
     }
 }
