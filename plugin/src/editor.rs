@@ -11,7 +11,7 @@ use crate::files::{
     preset_file_name, read_script, save_script, user_preset_dir, user_presets, FileBrowser,
     UserPreset,
 };
-use crate::model::{ModelState, ModelStatus, ModelStore, NUM_MACROS};
+use crate::model::{Loaded, ModelState, ModelStatus, ModelStore, NUM_MACROS};
 use crate::modes_view::ModesView;
 use crate::motion::MotionReader;
 use crate::params::RessortParams;
@@ -138,6 +138,8 @@ pub struct EditorApp {
     /// a state load) and the text has not been edited, the editor follows.
     synced: ModelState,
     message: Option<(String, Color32)>,
+    /// The submission being prepared in the background: its number, name and script.
+    loading: Option<(u64, String, String)>,
     browser: FileBrowser,
     /// The user preset folder, its presets (read when the Presets tab opens or after a save),
     /// and the name typed for the next save.
@@ -181,6 +183,7 @@ impl EditorApp {
             tab,
             preset,
             message: None,
+            loading: None,
             browser: FileBrowser::new(),
             user: user_dir.as_deref().map(user_presets).unwrap_or_default(),
             user_dir,
@@ -233,20 +236,35 @@ impl EditorApp {
         }
     }
 
+    /// Runs a script: prepared in the background ([`ModelStore::submit_in_background`]) while
+    /// the running model plays on; [`EditorApp::poll_loading`] reports how it went.
     fn submit(&mut self, name: String, script: String) {
-        let state = ModelState {
+        let ticket = self.store.submit_in_background(ModelState {
             name: name.clone(),
             script: script.clone(),
+        });
+        self.message = Some((format!("loading {name}…"), ORANGE));
+        self.loading = Some((ticket, name, script));
+    }
+
+    /// Reports the background submission once it has finished (each frame).
+    fn poll_loading(&mut self) {
+        let Some((ticket, _, _)) = &self.loading else {
+            return;
         };
-        match self.store.submit(state) {
-            Ok(()) => {
+        let Some(loaded) = self.store.take_loaded(*ticket) else {
+            return;
+        };
+        let (_, name, script) = self.loading.take().expect("a submission is loading");
+        match loaded {
+            Loaded::Running => {
                 self.message = Some((format!("{name} is running"), GREEN));
                 self.script = script;
                 self.script_name = name;
                 self.synced = self.store.running();
                 self.mark_edited();
             }
-            Err(rejected) => {
+            Loaded::Rejected(rejected) => {
                 self.script = script;
                 self.script_name = name;
                 self.tab = Tab::Script;
@@ -259,6 +277,17 @@ impl EditorApp {
                     RED,
                 ));
             }
+            // A state load or an A/B switch came after it, and its model runs instead.
+            Loaded::Overtaken => self.message = None,
+        }
+    }
+
+    /// Waits until the background submission has finished and reports it (tests).
+    #[cfg(test)]
+    fn finish_loading(&mut self) {
+        while self.loading.is_some() {
+            self.poll_loading();
+            std::thread::sleep(std::time::Duration::from_millis(1));
         }
     }
 
@@ -529,6 +558,7 @@ impl NiceEguiApp for EditorApp {
             self.reader = Some(r);
         }
         self.store.collect_garbage();
+        self.poll_loading();
         self.sync_script();
         self.report_trips();
         let status = self.store.status();
@@ -655,6 +685,7 @@ mod tests {
         app.gui = Some(GuiContext::new(recorder.clone()));
         let harmonic = Preset::find("harmonic-oscillator").unwrap();
         app.submit(harmonic.id.into(), harmonic.text.into());
+        app.finish_loading();
         assert_eq!(
             *recorder.calls.lock().unwrap(),
             [
@@ -665,6 +696,7 @@ mod tests {
         );
         recorder.calls.lock().unwrap().clear();
         app.submit("broken".into(), "@o osc 1. 0.1\n".into());
+        app.finish_loading();
         assert!(
             recorder.calls.lock().unwrap().is_empty(),
             "a rejected script is no edit"
@@ -710,6 +742,7 @@ mod tests {
         assert!(app.script.ends_with("# my edit\n"), "edits are kept");
         // A rejected script stays in the editor with its diagnostics; the model stays.
         app.submit("bad".into(), "@m mass 1 0\n@x nothing".into());
+        app.finish_loading();
         assert_eq!(store.running().name, "harmonic-oscillator");
         assert_eq!(app.tab, Tab::Script);
         assert!(!store.status().diagnostics.is_empty());

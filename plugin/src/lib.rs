@@ -71,6 +71,14 @@ pub struct Ressort {
     voices_watch: Option<VoicesWatch>,
 }
 
+impl Drop for Ressort {
+    fn drop(&mut self) {
+        // A model the editor is still preparing runs the plugin's code on its own thread: the
+        // host may unload the library once the instance is gone.
+        self.store.finish_loads();
+    }
+}
+
 /// How `ressort-standalone` starts: its `--model` and `--audition` options.
 #[derive(Clone, Debug, Default)]
 pub struct StandaloneStart {

@@ -2,7 +2,8 @@
 //! locks, and keeping the running script in the plugin state.
 //!
 //! A script becomes a [`Prepared`] model on the thread that submits it (the host's main
-//! thread for a state load or activation, the editor for an edit): parse, compile, stability
+//! thread for a state load or activation), or for the editor on a thread of its own, so that
+//! the editor keeps drawing while a large model's analyses run: parse, compile, stability
 //! envelope, macro ranges and scratch buffers are all made there. The audio thread receives it
 //! through a bounded lock-free channel and sends the replaced model back through another one,
 //! so it never allocates or frees. A script with errors never replaces the running model; its
@@ -28,6 +29,7 @@ use serde::{Deserialize, Serialize};
 pub const MAX_VOICES: usize = 128;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
 
 /// The saved part of the model: the script of the running model and where it came from.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -158,6 +160,17 @@ pub struct Compare {
     pub active: usize,
 }
 
+/// How a background submission ([`ModelStore::submit_in_background`]) ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Loaded {
+    /// The model runs (or, while the plugin is inactive, the script was checked).
+    Running,
+    /// The script has errors; the running model is unchanged.
+    Rejected(Rejected),
+    /// A later submission came first; this one was dropped unprepared.
+    Overtaken,
+}
+
 /// The model shared by the plugin, its parameters (as a persistent field) and the editor.
 #[derive(Debug)]
 pub struct ModelStore {
@@ -186,6 +199,15 @@ pub struct ModelStore {
     preparing: Mutex<()>,
     /// A copy of the running model for the editor's modal analysis, made when it was prepared.
     modal: Mutex<Option<Arc<ModalModel>>>,
+    /// Submissions so far (each takes the next number), so that a background preparation a
+    /// later submission overtook is dropped unprepared.
+    submissions: AtomicU64,
+    /// The number of the newest background submission that finished, and its outcome until
+    /// taken (an older one finishing later does not replace it).
+    background: Mutex<(u64, Option<Loaded>)>,
+    /// The threads of background submissions still running, joined by
+    /// [`ModelStore::finish_loads`] so that none outlives the plugin's code.
+    loads: Mutex<Vec<JoinHandle<()>>>,
     /// What the audio thread reports.
     pub runtime: RuntimeStatus,
 }
@@ -207,6 +229,9 @@ impl Default for ModelStore {
             compare: Mutex::new(Compare::default()),
             preparing: Mutex::new(()),
             modal: Mutex::new(None),
+            submissions: AtomicU64::new(0),
+            background: Mutex::new((0, None)),
+            loads: Mutex::new(Vec::new()),
             voices: AtomicU64::new(0),
             voices_stale: AtomicBool::new(false),
             runtime: RuntimeStatus::default(),
@@ -216,6 +241,14 @@ impl Default for ModelStore {
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Runs the job in `slot` unless it has run.
+fn run_once<F: FnOnce()>(slot: &Mutex<Option<F>>) {
+    let job = lock(slot).take();
+    if let Some(job) = job {
+        job();
+    }
 }
 
 impl ModelStore {
@@ -280,8 +313,72 @@ impl ModelStore {
     /// [`ModelStore::activate`] compiles it. A script with errors changes nothing but the
     /// diagnostics.
     pub fn submit(&self, state: ModelState) -> Result<(), Rejected> {
+        self.submissions.fetch_add(1, Ordering::AcqRel);
         let _preparing = lock(&self.preparing);
         self.submit_prepared(state)
+    }
+
+    /// [`ModelStore::submit`] on a thread of its own, for the editor: preparing a model takes
+    /// up to a few seconds (its modal analyses), and meanwhile the running model keeps
+    /// playing and the editor keeps drawing. Returns the submission's number;
+    /// [`ModelStore::take_loaded`] gives its outcome once it is known. A later submission,
+    /// from anywhere, overtakes this one if it has not started preparing yet.
+    pub fn submit_in_background(self: &Arc<Self>, state: ModelState) -> u64 {
+        let ticket = self.submissions.fetch_add(1, Ordering::AcqRel) + 1;
+        let store = Arc::clone(self);
+        let job = move || {
+            let loaded = {
+                let _preparing = lock(&store.preparing);
+                if store.submissions.load(Ordering::Acquire) != ticket {
+                    Loaded::Overtaken
+                } else {
+                    match store.submit_prepared(state) {
+                        Ok(()) => Loaded::Running,
+                        Err(rejected) => Loaded::Rejected(rejected),
+                    }
+                }
+            };
+            let mut newest = lock(&store.background);
+            if newest.0 < ticket {
+                *newest = (ticket, Some(loaded));
+            }
+        };
+        // The job is kept where a failed spawn leaves it, to run here instead.
+        let job = Arc::new(Mutex::new(Some(job)));
+        let spawned = {
+            let job = Arc::clone(&job);
+            std::thread::Builder::new()
+                .name("ressort-load".into())
+                .spawn(move || run_once(&job))
+        };
+        match spawned {
+            Ok(thread) => {
+                let mut loads = lock(&self.loads);
+                loads.retain(|t| !t.is_finished());
+                loads.push(thread);
+            }
+            // No thread to be had: prepare here, as `submit` does.
+            Err(_) => run_once(&job),
+        }
+        ticket
+    }
+
+    /// Waits for every background submission to finish (the plugin's drop).
+    pub fn finish_loads(&self) {
+        let loads = std::mem::take(&mut *lock(&self.loads));
+        for thread in loads {
+            let _ = thread.join();
+        }
+    }
+
+    /// The outcome of background submission `ticket`, once, when it has finished.
+    pub fn take_loaded(&self, ticket: u64) -> Option<Loaded> {
+        let mut newest = lock(&self.background);
+        if newest.0 == ticket {
+            newest.1.take()
+        } else {
+            None
+        }
     }
 
     /// [`ModelStore::submit`], with `preparing` held by the caller.
@@ -389,6 +486,7 @@ impl ModelStore {
     /// (so B starts where A is). A slot whose script no longer loads keeps the running model
     /// and reports why.
     pub fn switch_compare(&self) -> Result<(), Rejected> {
+        self.submissions.fetch_add(1, Ordering::AcqRel);
         let _preparing = lock(&self.preparing);
         let running = self.running();
         let mut c = lock(&self.compare);
@@ -491,5 +589,129 @@ impl<'a> PersistentField<'a, ModelState> for Arc<ModelStore> {
         F: Fn(&ModelState) -> R,
     {
         f(&lock(&self.running))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::presets::Preset;
+    use std::time::{Duration, Instant};
+
+    fn preset(id: &str) -> ModelState {
+        let p = Preset::find(id).expect("a preset");
+        ModelState {
+            name: p.id.into(),
+            script: p.text.into(),
+        }
+    }
+
+    /// An active store (48 kHz) running the default preset.
+    fn active() -> Arc<ModelStore> {
+        let store = Arc::new(ModelStore::default());
+        assert!(store.activate(48000.0).is_some());
+        store
+    }
+
+    fn wait(store: &ModelStore, ticket: u64) -> Loaded {
+        let start = Instant::now();
+        loop {
+            if let Some(loaded) = store.take_loaded(ticket) {
+                return loaded;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(120),
+                "submission {ticket} hangs"
+            );
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+
+    #[test]
+    fn a_background_submission_runs_its_model_and_reports_once() {
+        let store = active();
+        let sent = store.generation();
+        let ticket = store.submit_in_background(preset("harmonic-oscillator"));
+        assert_eq!(wait(&store, ticket), Loaded::Running);
+        assert_eq!(store.running().name, "harmonic-oscillator");
+        assert_eq!(store.status().summary.name, "harmonic-oscillator");
+        assert_eq!(
+            store.generation(),
+            sent + 1,
+            "one model sent to the audio thread"
+        );
+        assert_eq!(store.take_loaded(ticket), None, "reported once");
+    }
+
+    #[test]
+    fn the_plugin_waits_for_a_model_still_loading() {
+        // What the plugin's drop does: no preparing thread outlives it.
+        let store = active();
+        let ticket = store.submit_in_background(preset("hammer-oscillator"));
+        store.finish_loads();
+        assert!(lock(&store.loads).is_empty());
+        assert_eq!(store.take_loaded(ticket), Some(Loaded::Running));
+    }
+
+    #[test]
+    fn a_rejected_background_submission_keeps_the_running_model() {
+        let store = active();
+        let ticket = store.submit_in_background(ModelState {
+            name: "broken".into(),
+            script: "@m mass 1 0 0\n@s spring @m @nowhere 0.1\n".into(),
+        });
+        let Loaded::Rejected(rejected) = wait(&store, ticket) else {
+            panic!("the script has an error");
+        };
+        assert!(rejected.0[0].starts_with("2:"), "{:?}", rejected.0);
+        assert_eq!(store.running().name, crate::presets::DEFAULT_PRESET);
+        assert_eq!(
+            store.status().rejected.map(|r| r.name),
+            Some("broken".into())
+        );
+    }
+
+    #[test]
+    fn a_later_submission_overtakes_one_not_yet_prepared() {
+        // Two presets clicked while a model is still being prepared: the first is dropped
+        // unprepared, the second runs, and its outcome is not replaced by the first's.
+        let store = active();
+        let sent = store.generation();
+        let busy = lock(&store.preparing);
+        let first = store.submit_in_background(preset("hammer-oscillator"));
+        let second = store.submit_in_background(preset("harmonic-oscillator"));
+        drop(busy);
+        assert_eq!(wait(&store, second), Loaded::Running);
+        assert_eq!(store.running().name, "harmonic-oscillator");
+        // Let the first finish too (it may come second), then check it changed nothing.
+        std::thread::sleep(Duration::from_millis(50));
+        let _preparing = lock(&store.preparing);
+        assert_eq!(store.running().name, "harmonic-oscillator");
+        assert_eq!(store.generation(), sent + 1, "the first was never prepared");
+        assert_eq!(store.take_loaded(first), None);
+    }
+
+    #[test]
+    fn a_state_load_overtakes_a_background_submission() {
+        // The host loads a project while the editor's submission waits: the project's model
+        // runs, the editor's is dropped and says so.
+        let store = active();
+        let busy = lock(&store.preparing);
+        let ticket = store.submit_in_background(preset("hammer-oscillator"));
+        let host = {
+            let store = Arc::clone(&store);
+            std::thread::spawn(move || store.submit(preset("harmonic-oscillator")))
+        };
+        // The state load has taken its number (and waits for the lock) before the editor's
+        // submission may start.
+        let start = Instant::now();
+        while store.submissions.load(Ordering::Acquire) < ticket + 1 {
+            assert!(start.elapsed() < Duration::from_secs(60));
+            std::thread::yield_now();
+        }
+        drop(busy);
+        assert!(host.join().expect("no panic").is_ok());
+        assert_eq!(wait(&store, ticket), Loaded::Overtaken);
+        assert_eq!(store.running().name, "harmonic-oscillator");
     }
 }
