@@ -27,6 +27,7 @@ use super::system::{SymSparse, System};
 use crate::network::{Network, Valuation};
 use crate::{Engine, ScaleClass};
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::Side;
 
 /// Bisection steps: the limit to 2⁻⁴⁰ of its bracket.
@@ -55,14 +56,39 @@ impl StiffnessLimit {
 /// [`Engine::exact_stability`] off the audio thread.
 #[derive(Clone, Debug)]
 pub struct ExactStability {
-    /// 4M on the diagonal.
-    four_m: Vec<f64>,
-    /// K₁ + 2Z_K: the part scaled by the Stiffness gain.
-    a_k: SymSparse,
-    /// 2Z₁: the part scaled by the Damping gain.
-    a_z: SymSparse,
+    /// The lower triangle's pattern of 4M − g·(K₁ + 2Z_K) − 2h·Z₁, in compressed columns.
+    pattern: SymbolicSparseColMat<u32>,
+    /// Per stored entry of `pattern`, its terms: K₁ + 2Z_K (scaled by the Stiffness gain),
+    /// 2Z₁ (by the Damping gain) and 4M, each where that matrix has the entry.
+    terms: Vec<Terms>,
     applies: bool,
     symbolic: Option<SymbolicLlt<u32>>,
+}
+
+/// One entry's terms in [`ExactStability`].
+#[derive(Clone, Copy, Debug)]
+struct Terms {
+    k: Option<f64>,
+    z: Option<f64>,
+    m: Option<f64>,
+}
+
+impl Terms {
+    /// The entry at gains g and h: (−g)·k + (−h)·z + m over the terms present, summed in
+    /// that order (as [`SymSparse::combine`] sums them, so the factorisations see the same
+    /// values bit for bit).
+    fn at(self, g: f64, h: f64) -> f64 {
+        let k = self.k.map(|k| (-g) * k);
+        let z = self.z.map(|z| (-h) * z);
+        let kz = match (k, z) {
+            (Some(k), Some(z)) => Some(k + z),
+            (k, z) => k.or(z),
+        };
+        match (kz, self.m) {
+            (Some(v), Some(m)) => v + m,
+            (v, m) => v.or(m).unwrap_or(0.0),
+        }
+    }
 }
 
 impl ExactStability {
@@ -119,15 +145,14 @@ impl ExactStability {
     }
 
     fn positive_definite(&self, g: f64, h: f64) -> bool {
-        let b = SymSparse::combine(-g, &self.a_k, -h, &self.a_z, &self.four_m);
-        if b.n == 0 {
+        if self.terms.is_empty() {
             return true;
         }
-        let Some(mat) = b.lower() else {
-            return false;
-        };
+        // The values only: the pattern and its symbolic factorisation are made once.
+        let values: Vec<f64> = self.terms.iter().map(|t| t.at(g, h)).collect();
+        let mat = SparseColMatRef::new(self.pattern.as_ref(), &values);
         match &self.symbolic {
-            Some(sym) => Llt::try_new_with_symbolic(sym.clone(), mat.as_ref(), Side::Lower).is_ok(),
+            Some(sym) => Llt::try_new_with_symbolic(sym.clone(), mat, Side::Lower).is_ok(),
             None => mat.sp_cholesky(Side::Lower).is_ok(),
         }
     }
@@ -163,14 +188,11 @@ impl Engine {
             && net.k_ground.iter().chain(&net.z_ground).all(|v| *v >= 0.0)
             && a_k.is_finite()
             && a_z.is_finite();
-        let pattern = SymSparse::combine(1.0, &a_k, 1.0, &a_z, &four_m);
-        let symbolic = pattern
-            .lower()
-            .and_then(|m| SymbolicLlt::try_new(m.symbolic(), Side::Lower).ok());
+        let (pattern, terms) = entry_terms(&a_k, &a_z, &four_m);
+        let symbolic = SymbolicLlt::try_new(pattern.as_ref(), Side::Lower).ok();
         ExactStability {
-            four_m,
-            a_k,
-            a_z,
+            pattern,
+            terms,
             applies,
             symbolic,
         }
@@ -195,5 +217,97 @@ impl Engine {
             .filter(|l| l.k > 0.0)
             .map(|l| ((1.0 - damping_gain * l.z) / l.k).max(0.0))
             .fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// The union pattern of `a_k`, `a_z` and the diagonal `four_m` in compressed columns (rows
+/// ascending), with each stored entry's terms.
+fn entry_terms(
+    a_k: &SymSparse,
+    a_z: &SymSparse,
+    four_m: &[f64],
+) -> (SymbolicSparseColMat<u32>, Vec<Terms>) {
+    let n = four_m.len();
+    // Every entry of the three, by (column, row); the sort is stable, so an entry's terms
+    // come in the order k, z, m.
+    let mut all: Vec<(u32, u32, u8, f64)> =
+        Vec::with_capacity(a_k.entries.len() + a_z.entries.len() + n);
+    all.extend(a_k.entries.iter().map(|&(i, j, v)| (j, i, 0, v)));
+    all.extend(a_z.entries.iter().map(|&(i, j, v)| (j, i, 1, v)));
+    all.extend((0..n as u32).map(|i| (i, i, 2, four_m[i as usize])));
+    all.sort_by_key(|e| (e.0, e.1));
+    let mut col_ptr = vec![0u32; n + 1];
+    let mut row_idx = Vec::with_capacity(all.len());
+    let mut terms: Vec<Terms> = Vec::with_capacity(all.len());
+    let mut last = None;
+    for (col, row, which, v) in all {
+        if last != Some((col, row)) {
+            last = Some((col, row));
+            row_idx.push(row);
+            col_ptr[col as usize + 1] += 1;
+            terms.push(Terms {
+                k: None,
+                z: None,
+                m: None,
+            });
+        }
+        let t = terms.last_mut().expect("an entry was pushed");
+        let slot = match which {
+            0 => &mut t.k,
+            1 => &mut t.z,
+            _ => &mut t.m,
+        };
+        // A matrix has each entry once (SymSparse sums its duplicates).
+        *slot = Some(slot.map_or(v, |s| s + v));
+    }
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j];
+    }
+    let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+    (pattern, terms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn entry_terms_give_the_combined_matrix_bit_for_bit() {
+        // The precomputed pattern and terms against the matrix the bisection used to build
+        // for every factorisation: same pattern, same values (random sparse K, Z and M).
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        for n in 1..12u32 {
+            let mut random_entries = |count: u64| -> Vec<(u32, u32, f64)> {
+                (0..count)
+                    .map(|_| {
+                        let (i, j) = ((next() % n as u64) as u32, (next() % n as u64) as u32);
+                        (i, j, (next() % 1000) as f64 / 7.0 - 40.0)
+                    })
+                    .collect()
+            };
+            let k = SymSparse::from_entries(n as usize, random_entries(2 * n as u64));
+            let z = SymSparse::from_entries(n as usize, random_entries(n as u64));
+            let zeros = vec![0.0; n as usize];
+            let a_k = SymSparse::combine(1.0, &k, 2.0, &z, &zeros);
+            let a_z = SymSparse::combine(2.0, &z, 0.0, &k, &zeros);
+            let four_m: Vec<f64> = (0..n).map(|i| 4.0 + i as f64 / 3.0).collect();
+            let (pattern, terms) = entry_terms(&a_k, &a_z, &four_m);
+            for (g, h) in [(0.0, 0.0), (1.0, 1.0), (0.37, 2.5), (13.1, 0.0), (0.0, 7.9)] {
+                let old = SymSparse::combine(-g, &a_k, -h, &a_z, &four_m)
+                    .lower()
+                    .expect("a valid matrix");
+                let values: Vec<f64> = terms.iter().map(|t| t.at(g, h)).collect();
+                assert_eq!(old.symbolic().col_ptr(), pattern.col_ptr(), "n = {n}");
+                assert_eq!(old.symbolic().row_idx(), pattern.row_idx(), "n = {n}");
+                let bits = |v: &[f64]| v.iter().map(|x| (x + 0.0).to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(old.val()), bits(&values), "n = {n}, g = {g}, h = {h}");
+            }
+        }
     }
 }
