@@ -26,9 +26,11 @@
 use super::system::{SymSparse, System};
 use crate::network::{Network, Valuation};
 use crate::{Engine, ScaleClass};
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::Side;
+use faer::{Par, Side};
+use std::sync::Arc;
 
 /// Bisection steps: the limit to 2⁻⁴⁰ of its bracket.
 const BISECTION_STEPS: usize = 40;
@@ -62,7 +64,18 @@ pub struct ExactStability {
     /// 2Z₁ (by the Damping gain) and 4M, each where that matrix has the entry.
     terms: Vec<Terms>,
     applies: bool,
-    symbolic: Option<SymbolicLlt<u32>>,
+    /// The symbolic factorisation of `pattern` (None where faer could not make one: every
+    /// test then factorises from scratch).
+    symbolic: Option<Arc<SymbolicCholesky<u32>>>,
+}
+
+/// What one search reuses from factorisation to factorisation: the matrix's values, the
+/// factor's and faer's scratch (allocating and zeroing the factor each time was a sixth of
+/// a search on the Chladni plate).
+struct Workspace {
+    values: Vec<f64>,
+    factor: Vec<f64>,
+    scratch: Option<MemBuffer>,
 }
 
 /// One entry's terms in [`ExactStability`].
@@ -102,26 +115,30 @@ impl ExactStability {
     /// does not apply.
     pub fn is_stable(&self, stiffness_gain: f64, damping_gain: f64) -> Option<bool> {
         self.applies
-            .then(|| self.positive_definite(stiffness_gain, damping_gain))
+            .then(|| self.positive_definite(&mut self.workspace(), stiffness_gain, damping_gain))
     }
 
     /// The largest Stiffness gain that keeps the model stable at Damping gain `damping_gain`
     /// (infinite when no stiffness scales with it, 0 when the damping alone is unstable).
     pub fn max_stiffness(&self, damping_gain: f64) -> Option<f64> {
-        self.applies
-            .then(|| self.largest(|g| self.positive_definite(g, damping_gain)))
+        self.applies.then(|| {
+            let mut ws = self.workspace();
+            self.largest(|g| self.positive_definite(&mut ws, g, damping_gain))
+        })
     }
 
     /// The largest Damping gain that keeps the model stable at Stiffness gain
     /// `stiffness_gain`.
     pub fn max_damping(&self, stiffness_gain: f64) -> Option<f64> {
-        self.applies
-            .then(|| self.largest(|h| self.positive_definite(stiffness_gain, h)))
+        self.applies.then(|| {
+            let mut ws = self.workspace();
+            self.largest(|h| self.positive_definite(&mut ws, stiffness_gain, h))
+        })
     }
 
     /// The largest t ≥ 0 with `stable(t)`, assuming stability is lost once and for all as t
     /// grows (the quadratic form decreases in t).
-    fn largest(&self, stable: impl Fn(f64) -> bool) -> f64 {
+    fn largest(&self, mut stable: impl FnMut(f64) -> bool) -> f64 {
         if !stable(0.0) {
             return 0.0;
         }
@@ -144,16 +161,41 @@ impl ExactStability {
         lo
     }
 
-    fn positive_definite(&self, g: f64, h: f64) -> bool {
+    fn workspace(&self) -> Workspace {
+        Workspace {
+            values: vec![0.0; self.terms.len()],
+            factor: vec![0.0; self.symbolic.as_ref().map_or(0, |s| s.len_val())],
+            scratch: self.symbolic.as_ref().and_then(|s| {
+                MemBuffer::try_new(
+                    s.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+                )
+                .ok()
+            }),
+        }
+    }
+
+    fn positive_definite(&self, ws: &mut Workspace, g: f64, h: f64) -> bool {
         if self.terms.is_empty() {
             return true;
         }
         // The values only: the pattern and its symbolic factorisation are made once.
-        let values: Vec<f64> = self.terms.iter().map(|t| t.at(g, h)).collect();
-        let mat = SparseColMatRef::new(self.pattern.as_ref(), &values);
-        match &self.symbolic {
-            Some(sym) => Llt::try_new_with_symbolic(sym.clone(), mat, Side::Lower).is_ok(),
-            None => mat.sp_cholesky(Side::Lower).is_ok(),
+        for (v, t) in ws.values.iter_mut().zip(&self.terms) {
+            *v = t.at(g, h);
+        }
+        let mat = SparseColMatRef::new(self.pattern.as_ref(), &ws.values);
+        match (&self.symbolic, &mut ws.scratch) {
+            (Some(sym), Some(scratch)) => sym
+                .factorize_numeric_llt(
+                    &mut ws.factor,
+                    mat,
+                    Side::Lower,
+                    Default::default(),
+                    Par::Seq,
+                    MemStack::new(scratch),
+                    Default::default(),
+                )
+                .is_ok(),
+            _ => mat.sp_cholesky(Side::Lower).is_ok(),
         }
     }
 }
@@ -189,7 +231,14 @@ impl Engine {
             && a_k.is_finite()
             && a_z.is_finite();
         let (pattern, terms) = entry_terms(&a_k, &a_z, &four_m);
-        let symbolic = SymbolicLlt::try_new(pattern.as_ref(), Side::Lower).ok();
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.as_ref(),
+            Side::Lower,
+            Default::default(),
+            Default::default(),
+        )
+        .ok()
+        .map(Arc::new);
         ExactStability {
             pattern,
             terms,
