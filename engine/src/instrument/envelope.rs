@@ -230,10 +230,10 @@ pub fn raw_envelope(engine: &mut Engine) -> StabilityEnvelope {
         r.masses.iter().map(|m| m.coupled_load()).collect()
     };
     engine.set_class_gain(ScaleClass::Damping, 0.0);
-    let k = coupled(&engine.stability());
+    let k = coupled(&engine.stability_numbers());
     engine.set_class_gain(ScaleClass::Damping, 1.0);
     engine.set_class_gain(ScaleClass::Stiffness, 0.0);
-    let z = coupled(&engine.stability());
+    let z = coupled(&engine.stability_numbers());
     engine.set_class_gain(ScaleClass::Stiffness, 1.0);
     engine.apply_pending_changes();
     let loads = k

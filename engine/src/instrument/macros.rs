@@ -75,7 +75,7 @@ pub fn macro_bindings(engine: &mut Engine, settings: &HostSettings) -> Vec<Optio
         })
         .collect();
     let mut out: Vec<Option<MacroBinding>> = vec![None; NUM_MACROS];
-    let base_stable = engine.stability().is_stable();
+    let base_stable = engine.stability_numbers().is_stable();
     for (slot, (index, name, default, position)) in params.into_iter().take(NUM_MACROS).enumerate()
     {
         let id = ParamId(index as u32);
@@ -133,7 +133,7 @@ fn default_range(v: f64) -> (f64, f64) {
 fn stable_towards(engine: &mut Engine, id: ParamId, from: f64, target: f64) -> f64 {
     let stable_at = |engine: &mut Engine, v: f64| {
         engine.set_param(id, v).is_ok() && {
-            let r = engine.stability();
+            let r = engine.stability_numbers();
             worst_load(&r).0 < STABILITY_HEADROOM
         }
     };

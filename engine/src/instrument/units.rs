@@ -101,12 +101,12 @@ fn sums(r: &StabilityReport) -> (f64, f64, f64) {
 /// What the parameter of `b` is: the masses, stiffness or damping its value moves (the
 /// largest relative change wins). The engine is left at the declared value.
 pub fn role(engine: &mut Engine, b: &MacroBinding) -> Role {
-    let base = sums(&engine.stability());
+    let base = sums(&engine.stability_numbers());
     let other = if b.max != b.default { b.max } else { b.min };
     if other == b.default || engine.set_param(b.param, other).is_err() {
         return Role::Other;
     }
-    let moved = sums(&engine.stability());
+    let moved = sums(&engine.stability_numbers());
     let _ = engine.set_param(b.param, b.default);
     engine.apply_pending_changes();
     let rel = |a: f64, b: f64| (b - a).abs() / a.abs().max(1e-300);
