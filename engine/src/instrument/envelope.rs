@@ -172,19 +172,8 @@ pub fn exact_envelope(engine: &mut Engine) -> Option<StabilityEnvelope> {
         return None;
     }
     // Each limit is a bisection of some fifty sparse factorisations (a second for the largest
-    // plates): the two axes at once, the Damping one on a thread of its own.
-    let (z_max, k_max) = std::thread::scope(|s| {
-        let z = std::thread::Builder::new()
-            .name("ressort-limits".into())
-            .spawn_scoped(s, || ex.max_damping(0.0))
-            .ok();
-        let k_max = ex.max_stiffness(0.0);
-        let z_max = match z {
-            Some(h) => h.join().ok().flatten(),
-            None => ex.max_damping(0.0),
-        };
-        (z_max, k_max)
-    });
+    // plates): the two axes at once.
+    let (z_max, k_max) = super::concurrent::join(|| ex.max_damping(0.0), || ex.max_stiffness(0.0));
     let (z_max, k_max) = (z_max?, k_max?);
     let mut lines = Vec::new();
     if !z_max.is_finite() {

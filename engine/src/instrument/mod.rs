@@ -21,6 +21,7 @@
 //! sample. Nothing here allocates, locks or does I/O after [`Instrument::new`].
 
 pub mod analysis;
+mod concurrent;
 pub mod controls;
 pub mod dsp;
 pub mod envelope;

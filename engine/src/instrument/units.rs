@@ -150,27 +150,18 @@ pub fn unit_of(
             reference(e).map(pick)
         };
         // The positions at once: each but the first on its own thread, with its own copy of
-        // the engine. Where no thread can be had, a position is measured here.
-        let values: Vec<Option<f64>> = std::thread::scope(|s| {
-            let others: Vec<_> = TABLE_POSITIONS[1..]
-                .iter()
-                .map(|&n| {
-                    let mut copy = engine.clone();
-                    std::thread::Builder::new()
-                        .name("ressort-units".into())
-                        .spawn_scoped(s, move || measure(&mut copy, n))
-                        .ok()
-                })
-                .collect();
-            let mut values = vec![measure(engine, TABLE_POSITIONS[0])];
-            for (h, &n) in others.into_iter().zip(&TABLE_POSITIONS[1..]) {
-                values.push(match h {
-                    Some(h) => h.join().ok().flatten(),
-                    None => measure(engine, n),
-                });
-            }
-            values
-        });
+        // the engine.
+        let (mut middle, mut high) = (engine.clone(), engine.clone());
+        let ((v_high, v_middle), v_low) = super::concurrent::join(
+            || {
+                super::concurrent::join(
+                    || measure(&mut high, TABLE_POSITIONS[2]),
+                    || measure(&mut middle, TABLE_POSITIONS[1]),
+                )
+            },
+            || measure(engine, TABLE_POSITIONS[0]),
+        );
+        let values = [v_low, v_middle, v_high];
         let _ = engine.set_param(b.param, b.default);
         engine.apply_pending_changes();
         let points = TABLE_POSITIONS
