@@ -66,6 +66,9 @@ impl Controls {
         mpe: false,
     };
 
+    /// The controls of a project saved before the automatic output trim.
+    pub const LEGACY: Controls = Controls::DEFAULT;
+
     /// The smoothed controls as numbers, to notice automation between blocks. Non-finite
     /// values read as their defaults, so a bad host value never reaches the model.
     pub(super) fn sanitized(mut self) -> Controls {

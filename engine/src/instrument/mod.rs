@@ -39,7 +39,10 @@ pub use envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
 pub use events::{Event, Timed};
 pub use host::HostSettings;
 pub use macros::MacroBinding;
-pub use prepare::{parse_script, peak_frequency, prepare, InputRole, Prepared, Rejected, Watcher};
+pub use prepare::{
+    parse_script, peak_frequency, prepare, prepare_with, Conventions, InputRole, Prepared, Rejected,
+    Watcher,
+};
 
 use crate::RouteSource;
 use controls::{ClampView, ControlsKey, Smoothed, TuneKey};

@@ -109,8 +109,28 @@ pub fn parse_script(text: &str) -> Result<(ModelSpec, HostSettings, Vec<String>)
     Ok((spec, settings, warnings))
 }
 
+/// How a host plays a model: today's conventions, or those of projects saved before them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Conventions {
+    /// Concert pitch, the automatic output trim and the calibrated sidechain.
+    #[default]
+    Musical,
+    /// Projects saved before those: the relative tuning of `~key`, no trim, the raw sidechain.
+    Legacy,
+}
+
 /// Compiles a script for a sample rate and derives everything the audio thread needs.
 pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rejected> {
+    prepare_with(name, text, sample_rate, Conventions::Musical)
+}
+
+/// [`prepare`] under the given playing conventions.
+pub fn prepare_with(
+    name: &str,
+    text: &str,
+    sample_rate: f64,
+    _conventions: Conventions,
+) -> Result<Prepared, Rejected> {
     let (spec, settings, _warnings) = parse_script(text)?;
     let mut engine = compile(&spec, &CompileOptions::at(sample_rate))
         .map_err(|e| Rejected(e.0.iter().map(|e| format!("1:1: error: {e}")).collect()))?;
