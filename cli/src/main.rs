@@ -4,7 +4,7 @@
 //! ressort check MODEL.mdl
 //! ressort render MODEL.mdl -o OUT.wav [--sample-rate HZ] [--samples N | --seconds S]
 //!                [--input inK=FILE.wav]… [--impulse inK=AMPLITUDE]… [--set NAME=VALUE]…
-//! ressort render MODEL.mdl -o OUT.wav --as-plugin [--midi FILE.mid] [--note KEY[:VEL][@S]]…
+//! ressort render MODEL.mdl -o OUT.wav --as-plugin [--midi FILE.mid] [--note KEY[:VEL][@S][+LEN]]…
 //!                [--sidechain FILE.wav] [--main FILE.wav] [--control NAME=VALUE]…
 //! ressort bench MODEL.mdl [--sample-rate HZ] [--seconds S]
 //! ressort modes MODEL.mdl [--count N] [--sample-rate HZ] [--csv]
@@ -101,8 +101,9 @@ struct RenderArgs {
     /// lasts until 2 s after its last event unless a length is given.
     #[arg(long, value_name = "FILE.mid")]
     midi: Option<PathBuf>,
-    /// Play a note: key, velocity 0 … 1 (default 0.8), start in seconds: `60`, `64:0.5@0.25`.
-    #[arg(long = "note", value_name = "KEY[:VEL][@SECONDS]")]
+    /// Play a note: key, velocity 0 … 1 (default 0.8), start in seconds, and how long the key
+    /// stays down (else to the end): `60`, `64:0.5@0.25`, `60:0.8@0+1.5`.
+    #[arg(long = "note", value_name = "KEY[:VEL][@SECONDS][+LENGTH]")]
     notes: Vec<String>,
     /// Feed the plugin's sidechain (its channels in order; up to 8).
     #[arg(long, value_name = "FILE.wav")]
@@ -110,9 +111,9 @@ struct RenderArgs {
     /// Feed the plugin's main input (the effect layouts; stereo).
     #[arg(long, value_name = "FILE.wav")]
     main: Option<PathBuf>,
-    /// Set a plugin control: stiffness=×F, damping=×F, tune=ST, output-gain=DB,
+    /// Set a plugin control: stiffness=×F, damping=×F, tune=ST, a4=HZ, output-gain=DB,
     /// force-gain=DB, position-gain=DB, dc-filter=on|off, bend-range=ST, velocity-curve=EXP,
-    /// macroN=0…1.
+    /// trigger=on|off, sensitivity=DB, macroN=0…1.
     #[arg(
         long = "control",
         value_name = "NAME=VALUE",

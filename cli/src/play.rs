@@ -80,6 +80,22 @@ fn set_control(c: &mut Controls, text: &str) -> Result<(), Failure> {
             }
         }
         "release" => c.release = number()?.clamp(0.0, 1.0),
+        "a4" => {
+            let (lo, hi) = instrument::controls::A4_RANGE_HZ;
+            let v = number()?;
+            if !(lo..=hi).contains(&v) {
+                return Err(usage(format!("--control {text}: A4 takes {lo} … {hi} Hz")));
+            }
+            c.a4_hz = v;
+        }
+        "trigger" => {
+            c.trigger = match value.trim() {
+                "on" | "1" | "true" => true,
+                "off" | "0" | "false" => false,
+                v => return Err(usage(format!("--control trigger={v}: use on or off"))),
+            }
+        }
+        "sensitivity" => c.trigger_sensitivity_db = number()?.clamp(-40.0, 40.0),
         n if n.starts_with("macro") => {
             let slot: usize = n[5..]
                 .parse()
@@ -95,9 +111,9 @@ fn set_control(c: &mut Controls, text: &str) -> Result<(), Failure> {
         }
         n => {
             return Err(usage(format!(
-                "unknown control `{n}`; the controls are stiffness, damping, tune, \
+                "unknown control `{n}`; the controls are stiffness, damping, tune, a4, \
                  output-gain, force-gain, position-gain, dc-filter, bend-range, \
-                 velocity-curve, release, mpe and macro1 … macro{}",
+                 velocity-curve, release, mpe, trigger, sensitivity and macro1 … macro{}",
                 instrument::NUM_MACROS
             )))
         }
@@ -172,16 +188,28 @@ fn set_param(model: &mut Prepared, c: &mut Controls, text: &str) -> Result<(), F
         .map_err(|e| usage(format!("cannot set `{name}`: {e}")))
 }
 
-/// `--note KEY[:VELOCITY][@SECONDS]`: a note-on (velocity 0 … 1, default 0.8; time default 0).
-fn note(text: &str, sample_rate: f64) -> Result<(u64, Event), Failure> {
+/// `--note KEY[:VELOCITY][@SECONDS][+LENGTH]`: a note-on (velocity 0 … 1, default 0.8; time
+/// default 0), and its note-off LENGTH seconds later when given (else the key stays down).
+fn note(text: &str, sample_rate: f64) -> Result<Vec<(u64, Event)>, Failure> {
     let bad = || {
         usage(format!(
-            "--note {text}: expected KEY[:VELOCITY][@SECONDS], e.g. 60, 64:0.5 or 67:1@0.25"
+            "--note {text}: expected KEY[:VELOCITY][@SECONDS][+LENGTH], e.g. 60, 64:0.5, \
+             67:1@0.25 or 60:0.8@0+1.5"
         ))
     };
-    let (rest, at) = match text.split_once('@') {
+    let (text_on, length) = match text.rsplit_once('+') {
+        Some((on, len)) => {
+            let len: f64 = len.parse().map_err(|_| bad())?;
+            if !(len.is_finite() && len > 0.0) {
+                return Err(bad());
+            }
+            (on, Some(len))
+        }
+        None => (text, None),
+    };
+    let (rest, at) = match text_on.split_once('@') {
         Some((r, t)) => (r, t.parse::<f64>().map_err(|_| bad())?),
-        None => (text, 0.0),
+        None => (text_on, 0.0),
     };
     let (key, velocity) = match rest.split_once(':') {
         Some((k, v)) => (k, v.parse::<f32>().map_err(|_| bad())?),
@@ -191,15 +219,72 @@ fn note(text: &str, sample_rate: f64) -> Result<(u64, Event), Failure> {
     if !(at.is_finite() && at >= 0.0 && velocity.is_finite() && (0.0..=1.0).contains(&velocity)) {
         return Err(bad());
     }
-    Ok((
-        (at * sample_rate).round() as u64,
+    let start = (at * sample_rate).round() as u64;
+    let mut events = vec![(
+        start,
         Event::NoteOn {
             channel: 0,
             voice_id: None,
             note: key,
             velocity,
         },
-    ))
+    )];
+    if let Some(len) = length {
+        let end = ((at + len) * sample_rate).round() as u64;
+        events.push((end.max(start + 1), Event::note_off(key)));
+    }
+    Ok(events)
+}
+
+/// How the plugin plays a prepared model: its pitch and key, the keys it plays in tune, its
+/// exciters and its automatic trims.
+pub fn describe(m: &Prepared) -> String {
+    use ressort_engine::modes::note_name;
+    let s = &m.settings;
+    let key_name = |k: f64| {
+        note_name(440.0 * 2f64.powf((k.round() - 69.0) / 12.0)).map_or(String::new(), |n| n.0)
+    };
+    let pitch = match s.reference_pitch_hz {
+        Some(f) => {
+            let (name, cents) = note_name(f).unwrap_or_default();
+            format!("reference pitch {f:.2} Hz ({name} {cents:+.0} cents)")
+        }
+        None => "no reference pitch".to_string(),
+    };
+    let mode = if m.conventions == instrument::Conventions::Legacy {
+        format!("relative to key {:.2} (legacy project)", s.reference_key)
+    } else if s.unpitched {
+        format!("unpitched: as written at key {:.0}", s.reference_key)
+    } else {
+        format!("concert pitch: at key {:.2}", s.reference_key)
+    };
+    let top = m
+        .highest_key()
+        .map(|k| {
+            format!(
+                "; in tune up to key {:.0} ({})",
+                k.floor(),
+                key_name(k.floor())
+            )
+        })
+        .unwrap_or_default();
+    let exciters: Vec<String> = m
+        .exciters
+        .iter()
+        .map(|x| format!("{} in{}", x.kind.name(), x.input + 1))
+        .chain(m.note_input.map(|k| format!("strike in{}", k + 1)))
+        .collect();
+    format!(
+        "ressort: {pitch}, {mode}{top}; a key plays: {}; output trim {:+.1} dB, sidechain force \
+         trim {:+.1} dB",
+        if exciters.is_empty() {
+            "nothing".to_string()
+        } else {
+            exciters.join(", ")
+        },
+        20.0 * m.output_trim.log10(),
+        20.0 * m.input_trim.log10()
+    )
 }
 
 /// Renders through the instrument. See the module documentation.
@@ -237,6 +322,7 @@ pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
         }
         model.set_voices(v);
     }
+    eprintln!("{}", describe(&model));
     let mut controls = Controls::DEFAULT;
     for c in &a.controls {
         set_control(&mut controls, c)?;
@@ -247,7 +333,7 @@ pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
 
     let mut events: Vec<(u64, Event)> = Vec::new();
     for n in &a.notes {
-        events.push(note(n, srf)?);
+        events.extend(note(n, srf)?);
     }
     if let Some(path) = &a.midi {
         let bytes = std::fs::read(path)

@@ -52,8 +52,8 @@ pub use info::{InputUse, ModelInfo, OutputUse, PointInfo, PointKind};
 pub use lang::{parse, parse_bytes, print, Diagnostic, DiagnosticCode, Parsed, Severity};
 pub use motion::{MotionLayout, MotionStore, NamedBuffer};
 pub use spec::{
-    Element, ElementKind, Endpoint, HostSpec, Label, Law, MacroKind, MacroRange, MacroSpec,
-    ModelBuilder, ModelSpec, ParamDecl, ParamKind, Route, RouteSource, SampleRateMode, ScaleClass,
-    Span, Vector, REFERENCE_SAMPLE_RATE_HZ,
+    Element, ElementKind, Endpoint, ExciterDecl, ExciterKind, HostSpec, Label, Law, MacroKind,
+    MacroRange, MacroSpec, ModelBuilder, ModelSpec, ParamDecl, ParamKind, Route, RouteSource,
+    SampleRateMode, ScaleClass, Span, Vector, REFERENCE_SAMPLE_RATE_HZ,
 };
 pub use stability::{MassStability, StabilityReport, StabilityWarning};

@@ -11,7 +11,7 @@ use crate::expr::Expr;
 mod builder;
 mod host;
 pub use builder::ModelBuilder;
-pub use host::{HostSpec, MacroRange, Route, RouteSource};
+pub use host::{ExciterDecl, ExciterKind, HostSpec, MacroRange, Route, RouteSource};
 
 /// An element's label or the label an endpoint names, without `@`. Labels up to 23 bytes (nearly
 /// all) are stored inline, so a spec of thousands of elements holds no string per label, and a

@@ -12,9 +12,13 @@ fn spec(text: &str) -> ModelSpec {
     parsed.spec.expect("a spec")
 }
 
-fn preset(name: &str) -> ModelSpec {
+/// A gallery model as published, as the presets of `models/` stood before the instrument's
+/// exciters: the Oscillator tutorials' bow and plectrum forces as literals (the presets press
+/// them through an `audioParam`, which keeps a model out of the lanes), and every output the
+/// originals had (the falling balls and hammers move from the first sample).
+fn published(name: &str) -> ModelSpec {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../models")
+        .join("tests/legacy")
         .join(name);
     spec(&std::fs::read_to_string(path).unwrap())
 }
@@ -240,11 +244,11 @@ fn each_lane_is_a_plain_engine_bit_for_bit() {
         "gravity-oscillator.mdl",
         "struck-string.mdl",
     ] {
-        lanes_equal_plain(&preset(name), 48_000.0, k, z, strike);
+        lanes_equal_plain(&published(name), 48_000.0, k, z, strike);
     }
-    lanes_equal_plain(&preset("drunk-triangles.mdl"), 48_000.0, k, z, strike);
+    lanes_equal_plain(&published("drunk-triangles.mdl"), 48_000.0, k, z, strike);
     lanes_equal_plain(
-        &preset("drunk-triangles.mdl"),
+        &published("drunk-triangles.mdl"),
         44_100.0,
         [1.0; LANES],
         [1.0; LANES],

@@ -64,7 +64,8 @@ fn play(script: &str, events: &[(u32, Event)], sidechain: Option<&[f32]>) -> u64
             host[3] = Some(&s[done..]);
         }
         let (l, r) = out.split_at_mut(1);
-        let mut slices: [&mut [f32]; 2] = [&mut l[0][done..done + len], &mut r[0][done..done + len]];
+        let mut slices: [&mut [f32]; 2] =
+            [&mut l[0][done..done + len], &mut r[0][done..done + len]];
         inst.process(len, &host, false, &mut evs, &controls, &mut slices);
         done += len;
     }
@@ -77,17 +78,29 @@ const DIGESTS: &[(&str, u64, u64)] = &[
     ("bowed-string", 0x5eac53d274f9ef25, 0x1800fd53d3f3e0bb),
     ("brokendown-string", 0xc505b9459d8b24c5, 0x4143d25d9944028e),
     ("chladni-150x150", 0x78cd14442051eab9, 0x2fba98005daf963d),
-    ("coupled-strings-bowed", 0xdd8bea797cc1cbda, 0x5eac53d274f9ef25),
+    (
+        "coupled-strings-bowed",
+        0xdd8bea797cc1cbda,
+        0x5eac53d274f9ef25,
+    ),
     ("drunk-triangles", 0x6f384fc0214b3636, 0x9e0e20c433de5354),
     ("drunk-triangles-xl", 0x236aa5aae42f771f, 0x025ae94911a077cc),
     ("fretted-string", 0x997a28d2b0b37e38, 0x434f746563b1c5c7),
     ("gravity-oscillator", 0x6f384fc0214b3636, 0x9e0e20c433de5354),
     ("hammer-oscillator", 0x098b678c26f23bff, 0xc43ab8f35dec6f3b),
-    ("harmonic-oscillator", 0x14480de28473def5, 0xf17b610a073b2921),
+    (
+        "harmonic-oscillator",
+        0x14480de28473def5,
+        0xf17b610a073b2921,
+    ),
     ("mesh-15x15", 0xb43074cb659ae7e1, 0x069a245250554739),
     ("mesh-25x20", 0xb774fc0560a643bd, 0x0e80f6fc7f6abc61),
     ("nofx-drone", 0xe0f97bc5dad4addd, 0x07d9cdd4fc3280de),
-    ("nonlinear-oscillator", 0x9394aa925b723bc3, 0x8258b77b061bfbf5),
+    (
+        "nonlinear-oscillator",
+        0x9394aa925b723bc3,
+        0x8258b77b061bfbf5,
+    ),
     ("oscillator-bank", 0xd3ecc2d1412879fd, 0x699d14bbbb5cf041),
     ("plucked-harmonics", 0x5eac53d274f9ef25, 0xcb5e5062a908cf11),
     ("plucked-oscillator", 0x3dccfc48fb05e91e, 0xa216a8864d047336),

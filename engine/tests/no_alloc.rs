@@ -162,27 +162,44 @@ fn main() {
             "@K param 0.05\n@o osc 1. K 0.0005 0. 0.\n@g ground 0.1\n@h mass 1. 0.1 0.\n\
              @hs springDamper @g @h 0.0001 0.01\n@hit contact @o @h 0.1 0.001\n\
              @in1 frcInput @h\n@out1 posOutput @o\n",
+            false,
         ),
         (
             "instrument_note_storm_macros",
             "@s string 24 1. 0.1 0.0005 0. 0.\n@m cornerMesh 5 4 1. 0.1 0.001 0. 0.\n\
              @j springDamper [@s 0.5] [@m 0.5 0.5] 0.02 0.001\n@in1 frcInput [@s 0.3]\n\
              @out1 posOutput [@m 0.7 0.6]\n",
+            false,
+        ),
+        // Exciters on every voice: a bow whose friction a key presses, a plectrum, and a
+        // strike; the sidechain in trigger mode (onsets become voices).
+        (
+            "instrument_note_storm_exciters_trigger",
+            "@nlZ audioParam @in3\n@s string 24 1. 0.1 0.0005 0. 0.\n@in1 posInput 0.\n\
+             @in2 posInput 0.\n@b nlBow @in1 [@s 0.2] nlZ 0.00005\n\
+             @p nlPluck @in2 [@s 0.6] 0.1 0.005\n@in4 frcInput [@s 0.4]\n\
+             @out1 posOutput [@s 0.7]\n~exciter in1 bow\n~exciter in2 pluck\n\
+             ~exciter in3 press 0.1\n~exciter in4 strike\n~route in4 sidechain_1\n",
+            true,
         ),
     ];
-    for (name, script) in storms {
+    for (name, script, trigger) in storms {
         use ressort_engine::instrument::{self, Controls, Event, Instrument, Timed};
         let mut model = instrument::prepare("storm", script, 48_000.0).unwrap();
         model.set_voices(16);
         let controls = Controls {
             release: 0.5,
+            trigger,
             ..Controls::DEFAULT
         };
         let mut inst = Instrument::new(48_000.0, controls);
         inst.set_model(Box::new(model));
         inst.set_cc_map(&std::array::from_fn(|i| (i == 0).then_some(74)));
         let frames = 512;
-        let side = vec![0.01f32; frames];
+        // A click train on the sidechain: a hit every 128 samples for the trigger.
+        let side: Vec<f32> = (0..frames)
+            .map(|n| if n % 128 < 4 { 0.5 } else { 0.01 })
+            .collect();
         let (mut l, mut r) = (vec![0.0f32; frames], vec![0.0f32; frames]);
         let mut ended = 0usize;
         let (notes, allocations) = counted(|| {

@@ -7,7 +7,8 @@ mod common;
 use common::{engine, render};
 use ressort_engine::spec::REFERENCE_SAMPLE_RATE_HZ;
 use ressort_engine::{
-    parse, reference, ElementKind, Endpoint, InputUse, Law, ModelSpec, OutputUse, ParamKind,
+    parse, reference, ElementKind, Endpoint, ExciterKind, InputUse, Law, ModelSpec, OutputUse,
+    ParamKind,
 };
 use std::path::PathBuf;
 
@@ -164,7 +165,8 @@ fn role(spec: &ModelSpec, avatar: &str) -> Role {
 /// the string (from p to −p, or 4·Pscale down when they start on it); every other avatar held
 /// at its declared position (an input at 0 would make it jump there in one sample); the inputs
 /// of audio-rate parameters unfed (silent), as in the plugin's instrument layout, which feeds
-/// only `@in1` and `@in2`, and in `ressort render` without `--input`.
+/// only `@in1` and `@in2`, and in `ressort render` without `--input`, but for those a key
+/// presses (`~exciter inK press`), held at the press's depth.
 fn excitation(spec: &ModelSpec, inputs: &[Vec<InputUse>], sr: f64, frames: usize) -> Vec<Vec<f64>> {
     let value = lookup(spec);
     let z_scale = REFERENCE_SAMPLE_RATE_HZ / sr;
@@ -215,6 +217,20 @@ fn excitation(spec: &ModelSpec, inputs: &[Vec<InputUse>], sr: f64, frames: usize
             }
             Some(InputUse::Param(_)) => vec![0.0; frames],
             None => vec![0.0; frames],
+        })
+        .enumerate()
+        .map(|(k, signal)| {
+            // A key presses the input of an `audioParam` (a bow's friction, a plectrum's
+            // stiffness) to its exciter's depth: hold it there, as a held key does.
+            let press = spec
+                .host
+                .exciters
+                .iter()
+                .find(|x| x.input as usize == k + 1 && x.kind == ExciterKind::Press);
+            match (press, inputs[k].first()) {
+                (Some(x), Some(InputUse::Param(_))) => vec![x.amount.unwrap_or(0.0); frames],
+                _ => signal,
+            }
         })
         .collect()
 }
@@ -349,6 +365,12 @@ fn canonical_scripts_equal_the_builder_reference_models() {
         // physics must be the builder's.
         let mut parsed = preset(file);
         parsed.host = Default::default();
+        let mut spec = spec;
+        if file == "hammer-oscillator.mdl" {
+            // The preset leaves out the tutorial's second output, the hammer's height: an
+            // instrument listens to what sounds.
+            spec.elements.retain(|e| e.label != "out2");
+        }
         assert_eq!(parsed, spec, "{file} differs from the builder model");
     }
 }

@@ -3,7 +3,9 @@
 //! stealing does not click, the sustain pedal holds notes, and the motion view shows the
 //! most recently struck voice.
 
-use ressort_engine::instrument::{self, Controls, Event, Instrument, Timed, MAX_HOST_INPUTS};
+use ressort_engine::instrument::{
+    self, Controls, Conventions, Event, Instrument, Timed, MAX_HOST_INPUTS,
+};
 
 const SR: f64 = 48_000.0;
 
@@ -44,7 +46,29 @@ fn render_with(
     frames: usize,
     sidechain: Option<&[f32]>,
 ) -> Render {
-    let mut model = instrument::prepare("test", script, SR).unwrap();
+    render_as(
+        Conventions::Musical,
+        script,
+        voices,
+        controls,
+        events,
+        frames,
+        sidechain,
+    )
+}
+
+/// [`render_with`] under the given conventions: the legacy ones play the model's own units,
+/// without the automatic trims (the tests that read a force's displacement need them).
+fn render_as(
+    conventions: Conventions,
+    script: &str,
+    voices: usize,
+    controls: Controls,
+    events: &[(u32, Event)],
+    frames: usize,
+    sidechain: Option<&[f32]>,
+) -> Render {
+    let mut model = instrument::prepare_with("test", script, SR, conventions).unwrap();
     model.set_voices(voices);
     let mut inst = Instrument::new(SR, controls);
     inst.set_model(Box::new(model));
@@ -307,11 +331,17 @@ fn host_audio_still_strikes_the_model_without_notes() {
         damping_octaves: -1.0,
         ..quiet()
     };
-    let poly = render_with(DAMPED, 8, controls, &[], 24_000, Some(&side)).left;
-    let mono = render_with(DAMPED, 1, controls, &[], 24_000, Some(&side)).left;
-    let plain = render_with(DAMPED, 1, quiet(), &[], 24_000, Some(&side)).left;
+    let legacy = Conventions::Legacy;
+    let poly = render_as(legacy, DAMPED, 8, controls, &[], 24_000, Some(&side)).left;
+    let mono = render_as(legacy, DAMPED, 1, controls, &[], 24_000, Some(&side)).left;
+    let plain = render_as(legacy, DAMPED, 1, quiet(), &[], 24_000, Some(&side)).left;
     assert_ne!(mono, plain, "Stiffness and Damping must change the sound");
     assert!(peak(&mono) > 1e-3, "the sidechain strikes");
+    assert_eq!(poly, mono);
+    // Today's conventions: the same, at the model's home key and through its trims.
+    let poly = render_with(DAMPED, 8, controls, &[], 24_000, Some(&side)).left;
+    let mono = render_with(DAMPED, 1, controls, &[], 24_000, Some(&side)).left;
+    assert!(peak(&mono) > 1e-6, "the sidechain strikes");
     assert_eq!(poly, mono);
 }
 
@@ -324,13 +354,12 @@ fn drunk_triangles_play_100_overlapping_notes_and_free_their_voices() {
         "/../models/drunk-triangles.mdl"
     ))
     .unwrap();
-    let declared = instrument::prepare("dt", &text, SR)
-        .unwrap()
-        .settings
-        .voices;
-    assert_eq!(declared, Some(100));
+    let settings = instrument::prepare("dt", &text, SR).unwrap().settings;
+    assert_eq!(settings.voices, Some(100));
+    // Forty keys around the triangle's own pitch (in concert pitch, near D6).
+    let low = settings.reference_key.round() as u32 - 20;
     let events: Vec<(u32, Event)> = (0..100u32)
-        .map(|i| (i * 960, Event::note_on(40 + (i % 40) as u8, 0.8)))
+        .map(|i| (i * 960, Event::note_on((low + i % 40) as u8, 0.8)))
         .collect();
     let r = render(&text, 100, Controls::DEFAULT, &events, 12 * 48_000);
     let most = r.sounding.iter().copied().max().unwrap();
@@ -482,12 +511,15 @@ fn pressure_pushes_the_scripts_pressure_input() {
         note: Some(60),
         voice_id: None,
     };
-    let pressed = render(
+    // In the model's own units: a legacy project's, without the automatic trim.
+    let pressed = render_as(
+        Conventions::Legacy,
         &script,
         8,
         controls,
         &[(0, Event::note_on(60, 0.0)), (0, press)],
         96_000,
+        None,
     )
     .left;
     let gain = 10f64.powf(-12.0 / 20.0);
@@ -501,7 +533,16 @@ fn pressure_pushes_the_scripts_pressure_input() {
         note: None,
         voice_id: None,
     };
-    let mono = render(&script, 1, controls, &[(0, channel)], 96_000).left;
+    let mono = render_as(
+        Conventions::Legacy,
+        &script,
+        1,
+        controls,
+        &[(0, channel)],
+        96_000,
+        None,
+    )
+    .left;
     let settled = *mono.last().unwrap() as f64 / gain;
     assert!((settled - 0.025).abs() < 0.025 * 0.02, "{settled}");
 }

@@ -33,6 +33,7 @@ use std::time::Instant;
 
 mod controls_panel;
 mod model_panel;
+mod playing;
 
 /// The editor's size when first opened, in logical pixels.
 pub const DEFAULT_SIZE: (f32, f32) = (1100.0, 700.0);
@@ -151,6 +152,8 @@ pub struct EditorApp {
     last_frame: Option<Instant>,
     frame_times: [f32; 32],
     frame_count: usize,
+    /// The sidechain meter's level (dBFS), falling between peaks.
+    meter_db: f32,
 }
 
 impl EditorApp {
@@ -192,6 +195,7 @@ impl EditorApp {
             last_frame: None,
             frame_times: [0.0; 32],
             frame_count: 0,
+            meter_db: -60.0,
         }
     }
 
@@ -239,9 +243,13 @@ impl EditorApp {
     /// Runs a script: prepared in the background ([`ModelStore::submit_in_background`]) while
     /// the running model plays on; [`EditorApp::poll_loading`] reports how it went.
     fn submit(&mut self, name: String, script: String) {
+        // A model chosen in a legacy project is played as that project's were (its Output
+        // Gain was set for them); the editor's Update button moves the project on.
+        let playing = self.store.running().playing;
         let ticket = self.store.submit_in_background(ModelState {
             name: name.clone(),
             script: script.clone(),
+            playing,
         });
         self.message = Some((format!("loading {name}…"), ORANGE));
         self.loading = Some((ticket, name, script));
@@ -358,8 +366,8 @@ impl EditorApp {
                 "{} points · {} interactions",
                 s.points, s.interactions
             ));
-            if let Some(f) = s.reference_pitch_hz {
-                ui.label(format!("{f:.1} Hz at key {}", s.reference_key));
+            if let Some((text, hover)) = playing::pitch_text(s) {
+                ui.label(text).on_hover_text(hover);
             }
             let total = rt.voices_total.load(Ordering::Relaxed);
             if total > 1 {
@@ -598,6 +606,8 @@ impl NiceEguiApp for EditorApp {
                 egui::ScrollArea::vertical()
                     .id_salt("controls")
                     .show(ui, |ui| {
+                        self.playing(ui, &status);
+                        ui.separator();
                         self.controls(ui, &status);
                         ui.separator();
                         self.model_status(ui, &status);
@@ -723,20 +733,14 @@ mod tests {
         let mut app = EditorApp::new(params, store.clone());
         let hammer = Preset::find("hammer-oscillator").unwrap();
         store
-            .submit(ModelState {
-                name: hammer.id.into(),
-                script: hammer.text.into(),
-            })
+            .submit(ModelState::new(hammer.id, hammer.text))
             .unwrap();
         app.sync_script();
         assert_eq!(app.script, hammer.text);
         app.script.push_str("\n# my edit\n");
         let harmonic = Preset::find("harmonic-oscillator").unwrap();
         store
-            .submit(ModelState {
-                name: harmonic.id.into(),
-                script: harmonic.text.into(),
-            })
+            .submit(ModelState::new(harmonic.id, harmonic.text))
             .unwrap();
         app.sync_script();
         assert!(app.script.ends_with("# my edit\n"), "edits are kept");
@@ -754,12 +758,7 @@ mod tests {
         let store = Arc::new(ModelStore::default());
         let params = Arc::new(RessortParams::new(store.clone()));
         let bad = "@m mass 1 0 0\n@s spring @m @nowhere 0.1\n";
-        assert!(store
-            .submit(ModelState {
-                name: "broken".into(),
-                script: bad.into(),
-            })
-            .is_err());
+        assert!(store.submit(ModelState::new("broken", bad)).is_err());
         let app = EditorApp::new(params, store.clone());
         assert_eq!((app.tab, app.script.as_str()), (Tab::Script, bad));
         assert_eq!(

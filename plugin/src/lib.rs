@@ -557,6 +557,12 @@ impl Plugin for Ressort {
         self.follow_voices_setting(context);
 
         let rt = &self.store.runtime;
+        if report.input_peak > rt.input_peak.load(Ordering::Relaxed) {
+            rt.input_peak.store(report.input_peak, Ordering::Relaxed);
+        }
+        if report.triggered > 0 {
+            rt.triggered.fetch_add(report.triggered, Ordering::Relaxed);
+        }
         let seconds = frames as f64 / self.sample_rate;
         if seconds > 0.0 {
             let load = started.elapsed().as_secs_f64() / seconds;

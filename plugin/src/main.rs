@@ -41,19 +41,16 @@ fn main() {
 
 fn load(what: &str) -> ModelState {
     if let Some(p) = Preset::find(what) {
-        return ModelState {
-            name: p.id.into(),
-            script: p.text.into(),
-        };
+        return ModelState::new(p.id, p.text);
     }
     match std::fs::read_to_string(what) {
-        Ok(script) => ModelState {
-            name: std::path::Path::new(what)
+        Ok(script) => ModelState::new(
+            std::path::Path::new(what)
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "script".into()),
             script,
-        },
+        ),
         Err(e) => fail(&format!(
             "--model {what}: not a built-in model, and the file cannot be read: {e}"
         )),

@@ -31,13 +31,56 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
-/// The saved part of the model: the script of the running model and where it came from.
+/// How a saved model is played ([`instrument::Conventions`]), as the state stores it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Playing {
+    /// Concert pitch, the automatic output trim and the calibrated sidechain: every model
+    /// chosen in a project saved since they came.
+    #[default]
+    Musical,
+    /// A project saved before them (its state has no `playing` field): the relative tuning of
+    /// `~key`, no trim, the raw sidechain, as it sounded then.
+    Legacy,
+}
+
+impl Playing {
+    /// What a state without the field means.
+    fn legacy() -> Playing {
+        Playing::Legacy
+    }
+
+    pub fn conventions(self) -> instrument::Conventions {
+        match self {
+            Playing::Musical => instrument::Conventions::Musical,
+            Playing::Legacy => instrument::Conventions::Legacy,
+        }
+    }
+}
+
+/// The saved part of the model: the script of the running model, where it came from, and how
+/// it is played.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ModelState {
     /// A preset id (`mesh-25x20`) or a file name or "Custom".
     pub name: String,
     /// The complete script.
     pub script: String,
+    /// Absent from projects saved before concert pitch and the automatic levels, which keep
+    /// playing as they did.
+    #[serde(default = "Playing::legacy")]
+    pub playing: Playing,
+}
+
+impl ModelState {
+    /// A model played by today's conventions.
+    pub fn new(name: impl Into<String>, script: impl Into<String>) -> ModelState {
+        ModelState {
+            name: name.into(),
+            script: script.into(),
+            playing: Playing::Musical,
+        }
+    }
 }
 
 /// Prepares a script for the instrument ([`instrument::prepare`]) with a motion channel for
@@ -49,8 +92,9 @@ pub fn prepare(
     text: &str,
     sample_rate: f64,
     voices: usize,
+    playing: Playing,
 ) -> Result<(Prepared, MotionReader), Rejected> {
-    let mut prepared = instrument::prepare(name, text, sample_rate)?;
+    let mut prepared = instrument::prepare_with(name, text, sample_rate, playing.conventions())?;
     let declared = prepared.settings.voices.unwrap_or(1) as usize;
     prepared.set_voices(if voices == 0 { declared } else { voices });
     let (writer, reader) = motion_channel(&prepared.engine, sample_rate);
@@ -78,6 +122,18 @@ pub struct ModelSummary {
     pub declared_voices: Option<u32>,
     /// The voices the model was prepared with.
     pub voices: usize,
+    /// How the model is played: concert pitch or its own (`~unpitched`), or as a legacy
+    /// project did.
+    pub playing: Playing,
+    pub unpitched: bool,
+    /// The highest key in tune at default controls (the stability clamp holds the keys
+    /// above).
+    pub highest_key: Option<f64>,
+    /// The automatic trims, in dB: the output's and the sidechain force's.
+    pub output_trim_db: f64,
+    pub input_trim_db: f64,
+    /// What a key plays: `bow in1`, `strike in2`, … (empty: nothing but a voice of its own).
+    pub exciters: Vec<String>,
 }
 
 /// The result of a script submission.
@@ -148,6 +204,20 @@ pub fn summary(prepared: &mut Prepared) -> ModelSummary {
         reference_key: prepared.settings.reference_key,
         declared_voices: prepared.settings.voices,
         voices: prepared.voices(),
+        playing: match prepared.conventions {
+            instrument::Conventions::Musical => Playing::Musical,
+            instrument::Conventions::Legacy => Playing::Legacy,
+        },
+        unpitched: prepared.settings.unpitched,
+        highest_key: prepared.highest_key(),
+        output_trim_db: 20.0 * prepared.output_trim.log10(),
+        input_trim_db: 20.0 * prepared.input_trim.log10(),
+        exciters: prepared
+            .exciters
+            .iter()
+            .map(|x| format!("{} in{}", x.kind.name(), x.input + 1))
+            .chain(prepared.note_input.map(|k| format!("strike in{}", k + 1)))
+            .collect(),
     }
 }
 
@@ -216,10 +286,7 @@ impl Default for ModelStore {
     fn default() -> Self {
         let preset = crate::presets::Preset::default_preset();
         ModelStore {
-            running: Mutex::new(ModelState {
-                name: preset.id.to_string(),
-                script: preset.text.to_string(),
-            }),
+            running: Mutex::new(ModelState::new(preset.id, preset.text)),
             status: Mutex::new(ModelStatus::default()),
             sample_rate: AtomicU64::new(0),
             generation: AtomicU64::new(0),
@@ -391,7 +458,14 @@ impl ModelStore {
         // that changes from here on marks it stale again.
         let was_stale = rate > 0.0 && self.voices_stale.swap(false, Ordering::AcqRel);
         let result = if rate > 0.0 {
-            prepare(&state.name, &state.script, rate, self.voices()).map(Some)
+            prepare(
+                &state.name,
+                &state.script,
+                rate,
+                self.voices(),
+                state.playing,
+            )
+            .map(Some)
         } else {
             parse_script(&state.script).map(|_| None)
         };
@@ -530,20 +604,30 @@ impl ModelStore {
             .store(sample_rate.to_bits(), Ordering::Release);
         let state = self.running();
         let voices = self.voices();
-        let (mut prepared, reader) = match prepare(&state.name, &state.script, sample_rate, voices)
-        {
+        let prepared = prepare(
+            &state.name,
+            &state.script,
+            sample_rate,
+            voices,
+            state.playing,
+        );
+        let (mut prepared, reader) = match prepared {
             Ok(p) => p,
             Err(rejected) => {
                 let preset = crate::presets::Preset::default_preset();
-                let fallback = prepare(preset.id, preset.text, sample_rate, voices).ok()?;
+                let fallback = prepare(
+                    preset.id,
+                    preset.text,
+                    sample_rate,
+                    voices,
+                    Playing::Musical,
+                )
+                .ok()?;
                 let mut status = lock(&self.status);
                 status.diagnostics = rejected.0;
                 status.rejected = Some(state);
                 drop(status);
-                *lock(&self.running) = ModelState {
-                    name: preset.id.to_string(),
-                    script: preset.text.to_string(),
-                };
+                *lock(&self.running) = ModelState::new(preset.id, preset.text);
                 fallback
             }
         };
@@ -600,10 +684,7 @@ mod tests {
 
     fn preset(id: &str) -> ModelState {
         let p = Preset::find(id).expect("a preset");
-        ModelState {
-            name: p.id.into(),
-            script: p.text.into(),
-        }
+        ModelState::new(p.id, p.text)
     }
 
     /// An active store (48 kHz) running the default preset.
@@ -656,10 +737,10 @@ mod tests {
     #[test]
     fn a_rejected_background_submission_keeps_the_running_model() {
         let store = active();
-        let ticket = store.submit_in_background(ModelState {
-            name: "broken".into(),
-            script: "@m mass 1 0 0\n@s spring @m @nowhere 0.1\n".into(),
-        });
+        let ticket = store.submit_in_background(ModelState::new(
+            "broken",
+            "@m mass 1 0 0\n@s spring @m @nowhere 0.1\n",
+        ));
         let Loaded::Rejected(rejected) = wait(&store, ticket) else {
             panic!("the script has an error");
         };

@@ -7,6 +7,7 @@ use crate::param_text::{
     parse_factor, parse_semitones, parse_switch, parse_velocity_curve,
 };
 use nice_plug::prelude::*;
+use ressort_engine::instrument::controls::A4_RANGE_HZ;
 use ressort_engine::instrument::Controls;
 use std::sync::Arc;
 
@@ -90,6 +91,18 @@ pub struct RessortParams {
     #[id = "velocity_curve"]
     pub velocity_curve: FloatParam,
 
+    /// The tuning reference: the pitch of A4 in Hz (concert pitch; Tune adds to it).
+    #[id = "a4"]
+    pub a4: FloatParam,
+
+    /// Sidechain trigger mode: onsets on the sidechain strike the model (play a voice)
+    /// instead of pushing it as a force.
+    #[id = "sc_trigger"]
+    pub trigger: BoolParam,
+    /// dB added to a sidechain hit's level before it becomes a velocity.
+    #[id = "sc_sensitivity"]
+    pub trigger_sensitivity: FloatParam,
+
     /// Generic slots bound to the model's `param`s in declaration order.
     #[nested(array, group = "Macros")]
     pub macros: [MacroParam; NUM_MACROS],
@@ -147,6 +160,9 @@ impl RessortParams {
             release: self.release.value() as f64,
             mpe: self.mpe.value(),
             velocity_exponent: 2f64.powf(self.velocity_curve.value() as f64),
+            a4_hz: self.a4.value() as f64,
+            trigger: self.trigger.value(),
+            trigger_sensitivity_db: self.trigger_sensitivity.value() as f64,
         }
     }
 
@@ -251,6 +267,30 @@ impl RessortParams {
             )
             .with_value_to_string(Arc::new(format_velocity_curve))
             .with_string_to_value(Arc::new(|t| parse_velocity_curve(t, VELOCITY_OCTAVES))),
+            a4: FloatParam::new(
+                "A4",
+                d.a4_hz as f32,
+                FloatRange::Linear {
+                    min: A4_RANGE_HZ.0 as f32,
+                    max: A4_RANGE_HZ.1 as f32,
+                },
+            )
+            .with_unit(" Hz")
+            .with_step_size(0.1)
+            .with_value_to_string(Arc::new(|hz| format!("{hz:.1}")))
+            .with_string_to_value(Arc::new(|t| {
+                let t = t.trim().trim_end_matches("Hz").trim();
+                t.parse::<f32>()
+                    .ok()
+                    .filter(|v| (A4_RANGE_HZ.0 as f32..=A4_RANGE_HZ.1 as f32).contains(v))
+            })),
+            trigger: BoolParam::new("Sidechain Trigger", d.trigger),
+            trigger_sensitivity: gain_param(
+                "Trigger Sensitivity",
+                d.trigger_sensitivity_db as f32,
+                -24.0,
+                24.0,
+            ),
             guard: BoolParam::new("Guard Tripped", false)
                 .non_automatable()
                 .with_value_to_string(Arc::new(|on| {

@@ -36,6 +36,11 @@ pub struct RuntimeStatus {
     /// Set by the editor's reset button; the audio thread resets the model at its next block
     /// and clears the guard flag.
     pub reset_requested: AtomicBool,
+    /// The loudest sidechain sample that pushes the model (or triggers it) since the editor
+    /// last read it: the input meter's.
+    pub input_peak: AtomicF64,
+    /// Strikes the sidechain trigger has played.
+    pub triggered: AtomicU32,
 }
 
 impl Default for RuntimeStatus {
@@ -56,6 +61,8 @@ impl Default for RuntimeStatus {
             macros: std::array::from_fn(|_| AtomicF64::new(0.5)),
             voices_sounding: AtomicU32::new(1),
             voices_total: AtomicU32::new(1),
+            input_peak: AtomicF64::new(0.0),
+            triggered: AtomicU32::new(0),
         }
     }
 }

@@ -91,10 +91,10 @@ mod tests {
     }
 
     fn script(name: &str, k: f64) -> ModelState {
-        ModelState {
-            name: name.into(),
-            script: format!("@o osc 1. {k} 0.0002 0. 0.\n@in1 frcInput @o\n@out1 posOutput @o\n"),
-        }
+        ModelState::new(
+            name,
+            format!("@o osc 1. {k} 0.0002 0. 0.\n@in1 frcInput @o\n@out1 posOutput @o\n"),
+        )
     }
 
     /// A state load sets Voices, then the model: that model is prepared with the new setting,

@@ -173,10 +173,10 @@ fn a_bad_script_keeps_the_running_model_and_reports_where() {
     let store = ModelStore::default();
     let before = store.running();
     let err = store
-        .submit(ModelState {
-            name: "broken".into(),
-            script: "@m mass 1 0 0\n@s spring @m @nowhere 0.1\n".into(),
-        })
+        .submit(ModelState::new(
+            "broken",
+            "@m mass 1 0 0\n@s spring @m @nowhere 0.1\n",
+        ))
         .unwrap_err();
     assert_eq!(store.running(), before);
     let status = store.status();
@@ -185,12 +185,7 @@ fn a_bad_script_keeps_the_running_model_and_reports_where() {
     assert_eq!(status.rejected.unwrap().name, "broken");
 
     let good = Preset::find("string-1000").unwrap();
-    store
-        .submit(ModelState {
-            name: good.id.into(),
-            script: good.text.into(),
-        })
-        .unwrap();
+    store.submit(ModelState::new(good.id, good.text)).unwrap();
     assert_eq!(store.running().name, "string-1000");
     assert!(store.status().diagnostics.is_empty());
 }
@@ -290,7 +285,7 @@ fn every_preset_moves_its_first_output_when_played() {
                 }
                 host_in[3] = host_in[2];
             }
-            p.fill_inputs(&host_in, order, CHUNK, 1.0, 1.0);
+            p.fill_inputs(&host_in, order, CHUNK, 1.0, 1.0, false);
             if let (Some(k), Some(strike), 0) = (p.note_input, strike, block) {
                 p.inputs[k * CHUNK] += strike;
             }

@@ -12,6 +12,9 @@ use super::prepare::Prepared;
 use super::{CHUNK, NUM_MACROS};
 use crate::{Engine, ParamId, ScaleClass};
 
+/// The range of the A4 reference, Hz.
+pub const A4_RANGE_HZ: (f64, f64) = (400.0, 480.0);
+
 /// Smoothing time constant of the physical controls.
 const CONTROL_SMOOTHING_MS: f64 = 15.0;
 /// Smoothing time constant of the gains.
@@ -47,6 +50,15 @@ pub struct Controls {
     /// The damper a released voice gets, 0 … 1: its Damping gain × 16^release (0: it rings
     /// on as a struck object does).
     pub release: f64,
+    /// The tuning reference: the pitch of A4 in Hz. It moves every model by
+    /// 12·log₂(A4/440) semitones, with Tune.
+    pub a4_hz: f64,
+    /// Sidechain trigger mode: onsets on the host's force signals strike the model (play a
+    /// voice) instead of pushing it.
+    pub trigger: bool,
+    /// The trigger's sensitivity in dB: added to an onset's level before it becomes a
+    /// velocity ([`super::trigger`]).
+    pub trigger_sensitivity_db: f64,
 }
 
 impl Controls {
@@ -55,7 +67,7 @@ impl Controls {
         stiffness_octaves: 0.0,
         damping_octaves: 0.0,
         tune_st: 0.0,
-        output_db: 24.0,
+        output_db: 0.0,
         force_db: 0.0,
         position_db: 0.0,
         macros: [0.5; NUM_MACROS],
@@ -64,10 +76,22 @@ impl Controls {
         velocity_exponent: 1.0,
         release: 0.0,
         mpe: false,
+        a4_hz: 440.0,
+        trigger: false,
+        trigger_sensitivity_db: 0.0,
     };
 
-    /// The controls of a project saved before the automatic output trim.
-    pub const LEGACY: Controls = Controls::DEFAULT;
+    /// The controls a project saved before the automatic output trim started with: Output
+    /// Gain +24 dB.
+    pub const LEGACY: Controls = Controls {
+        output_db: 24.0,
+        ..Controls::DEFAULT
+    };
+
+    /// The A4 reference as semitones from 440 Hz.
+    pub fn a4_semitones(&self) -> f64 {
+        12.0 * (self.a4_hz / 440.0).log2()
+    }
 
     /// The smoothed controls as numbers, to notice automation between blocks. Non-finite
     /// values read as their defaults, so a bad host value never reaches the model.
@@ -88,6 +112,9 @@ impl Controls {
         fix(&mut self.velocity_exponent, d.velocity_exponent);
         fix(&mut self.release, d.release);
         self.release = self.release.clamp(0.0, 1.0);
+        fix(&mut self.a4_hz, d.a4_hz);
+        self.a4_hz = self.a4_hz.clamp(A4_RANGE_HZ.0, A4_RANGE_HZ.1);
+        fix(&mut self.trigger_sensitivity_db, d.trigger_sensitivity_db);
         for m in &mut self.macros {
             fix(m, 0.5);
         }
@@ -246,7 +273,7 @@ impl Smoothed {
         Smoothed {
             stiffness: control(c.stiffness_octaves),
             damping: control(c.damping_octaves),
-            tune: control(c.tune_st),
+            tune: control(c.tune_st + c.a4_semitones()),
             force_gain: gain(c.force_db),
             position_gain: gain(c.position_db),
             output_gain: gain(c.output_db),
@@ -260,7 +287,7 @@ impl Smoothed {
     pub fn advance(&mut self, n: usize, c: &Controls, bend_st: f64) {
         self.stiffness.advance(n, c.stiffness_octaves);
         self.damping.advance(n, c.damping_octaves);
-        self.tune.advance(n, c.tune_st + bend_st);
+        self.tune.advance(n, c.tune_st + bend_st + c.a4_semitones());
         self.force_gain.advance(n, db_to_gain(c.force_db));
         self.position_gain.advance(n, db_to_gain(c.position_db));
         self.output_gain.advance(n, db_to_gain(c.output_db));

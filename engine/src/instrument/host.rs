@@ -1,7 +1,7 @@
 //! What a script tells the plugin beyond the physics: input routing, the MIDI note target,
 //! the reference pitch and key, and macro ranges.
 
-use crate::{MacroRange, ModelSpec, RouteSource};
+use crate::{ExciterKind, MacroRange, ModelSpec, RouteSource};
 
 /// The default order: `@in1`, `@in2`… take the main input's left and right channels when
 /// the plugin has a main input (effect layouts), then the sidechain's channels 1 … 8.
@@ -47,8 +47,15 @@ pub const DEFAULT_PRESSURE: f64 = 0.001;
 pub struct HostSettings {
     /// Per model input (index 0 = `@in1`): the host channel chosen by the script.
     pub routing: Vec<Option<RouteSource>>,
-    /// The model input (0-based) that MIDI notes strike; default: the first force input.
+    /// The model input (0-based) that MIDI notes strike (`~note`, `~exciter … strike`);
+    /// default: the first force input, unless the script declares other exciters.
     pub note_input: Option<u32>,
+    /// The script declares exciters (`~exciter`): a note plays those, and strikes only the
+    /// input its `strike` names.
+    pub has_exciters: bool,
+    /// `~unpitched`: the model keeps its own pitch at `reference_key` instead of playing in
+    /// concert pitch.
+    pub unpitched: bool,
     /// The force of a full-velocity note, before the Force gain.
     pub note_force: f64,
     /// The model's pitch in Hz at its reference key, when the script declares it.
@@ -69,6 +76,8 @@ impl Default for HostSettings {
         HostSettings {
             routing: Vec::new(),
             note_input: None,
+            has_exciters: false,
+            unpitched: false,
             note_force: -0.02,
             reference_pitch_hz: None,
             reference_key: 60.0,
@@ -82,7 +91,8 @@ impl Default for HostSettings {
 
 impl HostSettings {
     /// Reads the host directives of a parsed model (`~pitch`, `~key`, `~note`, `~route`,
-    /// `~macro`, `~voices`, `~pressure`; see docs/LANGUAGE.md §12.3).
+    /// `~macro`, `~voices`, `~pressure`, `~exciter`, `~unpitched`; see docs/LANGUAGE.md §12.3,
+    /// §12.4).
     pub fn from_spec(spec: &ModelSpec) -> Result<HostSettings, Vec<String>> {
         let h = &spec.host;
         let defaults = HostSettings::default();
@@ -94,10 +104,17 @@ impl HostSettings {
             }
             routing[i] = Some(r.source);
         }
+        let strike = h.exciters.iter().find(|e| e.kind == ExciterKind::Strike);
+        let (note_input, note_force) = match strike {
+            Some(e) => (Some(e.input), e.amount),
+            None => (h.note_input, h.note_force),
+        };
         Ok(HostSettings {
             routing,
-            note_input: h.note_input.map(|k| k - 1),
-            note_force: h.note_force.unwrap_or(defaults.note_force),
+            note_input: note_input.map(|k| k - 1),
+            has_exciters: !h.exciters.is_empty(),
+            unpitched: h.unpitched,
+            note_force: note_force.unwrap_or(defaults.note_force),
             reference_pitch_hz: h.pitch_hz,
             reference_key: h.key.unwrap_or(defaults.reference_key),
             macro_ranges: h.macro_ranges.clone(),

@@ -26,10 +26,13 @@ pub mod controls;
 pub mod dsp;
 pub mod envelope;
 pub mod events;
+pub mod exciters;
 pub mod host;
+pub mod level;
 pub mod macros;
 pub mod output;
 pub mod prepare;
+pub mod trigger;
 pub mod units;
 pub mod voices;
 
@@ -40,15 +43,15 @@ pub use events::{Event, Timed};
 pub use host::HostSettings;
 pub use macros::MacroBinding;
 pub use prepare::{
-    parse_script, peak_frequency, prepare, prepare_with, Conventions, InputRole, Prepared, Rejected,
-    Watcher,
+    parse_script, peak_frequency, prepare, prepare_with, Conventions, InputRole, Prepared,
+    Rejected, Watcher,
 };
 
 use crate::RouteSource;
 use controls::{ClampView, ControlsKey, Smoothed, TuneKey};
 use events::Modulated;
 use output::{OutputStage, Span};
-pub use voices::{Ended, VoiceBank, VoiceState};
+pub use voices::{Drive, Ended, VoiceBank, VoiceState};
 
 /// The engine runs in chunks of at most this many samples; gains and macros are updated at
 /// chunk boundaries (counted from activation, so results do not depend on the host's block
@@ -84,6 +87,22 @@ macro_rules! clamp_view {
 mod expression;
 use expression::{tune_voice, SharedGains};
 
+/// The host channels ([`host::channel`] numbering, as bits) that feed the force inputs of
+/// `m`: by the script's `~route`s, else in `order`.
+pub(crate) fn force_channels(m: &Prepared, order: &[RouteSource]) -> u16 {
+    let mut mask = 0u16;
+    for (k, role) in m.roles.iter().enumerate() {
+        if *role != InputRole::Force {
+            continue;
+        }
+        let source = m.routing[k].or_else(|| order.get(k).copied());
+        if let Some(c) = source.and_then(host::channel) {
+            mask |= 1 << c;
+        }
+    }
+    mask
+}
+
 /// The sustain pedal's controller: it holds released voices.
 pub const SUSTAIN_CC: u8 = 64;
 
@@ -100,6 +119,11 @@ pub struct BlockReport {
     pub loudest: f64,
     /// A model crossfade is still running.
     pub fading: bool,
+    /// The loudest sample of the host channels that push the model's force inputs (or, in
+    /// trigger mode, play it): the editor's input meter.
+    pub input_peak: f64,
+    /// Strikes the sidechain trigger played.
+    pub triggered: u32,
 }
 
 /// A model played by notes, knobs and host audio. See the module documentation.
@@ -131,8 +155,9 @@ pub struct Instrument {
     /// Samples since the start: chunk boundaries are multiples of CHUNK.
     counter: u64,
     output: OutputStage,
-    /// Semitones from the reference key of the last note, and the pitch bend.
-    note_st: f64,
+    /// The key of the last note the one model played (its home key until then), and the
+    /// pitch bend.
+    note_key: Option<u8>,
     bend_st: f64,
     /// The one model's own note tuning (semitones) and pressure (0 … 1); with voices, the
     /// pressure that reaches the model itself (channel pressure without MPE).
@@ -153,6 +178,8 @@ pub struct Instrument {
     host_macros: [f64; NUM_MACROS],
     cc_macros: [Option<f64>; NUM_MACROS],
     host_in: [[f64; CHUNK]; MAX_HOST_INPUTS],
+    /// The sidechain's onset detector (trigger mode).
+    trigger: trigger::Trigger,
 }
 
 impl Instrument {
@@ -178,7 +205,7 @@ impl Instrument {
             chunk_done: 0,
             counter: 0,
             output: OutputStage::new(sample_rate),
-            note_st: 0.0,
+            note_key: None,
             bend_st: 0.0,
             tuning_st: 0.0,
             pressure: 0.0,
@@ -190,6 +217,7 @@ impl Instrument {
             host_macros: controls.macros,
             cc_macros: [None; NUM_MACROS],
             host_in: [[0.0; CHUNK]; MAX_HOST_INPUTS],
+            trigger: trigger::Trigger::new(sample_rate),
         }
     }
 
@@ -284,7 +312,7 @@ impl Instrument {
             }
         }
         self.fade_left = 0;
-        self.note_st = 0.0;
+        self.note_key = None;
         self.bend_st = 0.0;
         self.tuning_st = 0.0;
         self.pressure = 0.0;
@@ -299,6 +327,7 @@ impl Instrument {
         self.counter = 0;
         self.chunk_len = 0;
         self.chunk_done = 0;
+        self.trigger.reset();
         self.apply();
         self.outgoing.take()
     }
@@ -321,14 +350,17 @@ impl Instrument {
         let Some(m) = self.current.as_deref_mut() else {
             return;
         };
+        // The model itself, which the host's audio plays (with voices), sits at its home key.
+        let home_st = m.home_key() - m.settings.reference_key;
         let Some(bank) = m.bank.as_mut() else {
-            self.gains = self.smoothed.apply(m, self.note_st + self.tuning_st);
+            let key = self.note_key.map_or(m.home_key(), f64::from);
+            let note_st = key - m.settings.reference_key;
+            self.gains = self.smoothed.apply(m, note_st + self.tuning_st);
             return;
         };
         let view = clamp_view!(m);
         let release = 16f64.powf(self.controls.release);
-        // The model itself, which the host's audio plays, at the reference key.
-        let mut shown = self.smoothed.gains(&view, 0.0, 1.0);
+        let mut shown = self.smoothed.gains(&view, home_st, 1.0);
         self.smoothed.set(&mut m.engine, view.macros, &shown);
         let mut newest = 0;
         self.shared_gains.clear();
@@ -421,6 +453,48 @@ impl Instrument {
         let mut automated = controls != self.controls;
         self.controls = controls;
         let mut report = BlockReport::default();
+        // The host channels that push force inputs: the input meter's, and the trigger's.
+        let mask = self
+            .current
+            .as_deref()
+            .map_or(0, |m| force_channels(m, self.order));
+        let host_sample = |c: usize, n: usize| -> f64 {
+            let src: Option<&[f32]> = if main_in_place && c < 2 {
+                out.get(c).map(|s| &**s)
+            } else {
+                host_in.get(c).copied().flatten()
+            };
+            src.and_then(|s| s.get(n))
+                .copied()
+                .map_or(0.0, dsp::input_sample)
+                .abs()
+        };
+        let level = |n: usize| -> f64 {
+            let mut a: f64 = 0.0;
+            for c in 0..MAX_HOST_INPUTS {
+                if mask & (1 << c) != 0 {
+                    a = a.max(host_sample(c, n));
+                }
+            }
+            a
+        };
+        if mask != 0 {
+            for n in 0..frames {
+                report.input_peak = report.input_peak.max(level(n));
+            }
+        }
+        let mut onsets = [Timed::new(0, Event::Strike { velocity: 0.0 }); trigger::MAX_ONSETS];
+        let mut n_onsets = 0;
+        if self.controls.trigger && mask != 0 {
+            let found = self
+                .trigger
+                .scan(frames, self.controls.trigger_sensitivity_db, level);
+            n_onsets = found.len();
+            onsets[..n_onsets].copy_from_slice(found);
+            report.triggered = n_onsets as u32;
+        }
+        let mut merged = trigger::Merge::new(events, &onsets[..n_onsets]);
+        let events = &mut merged;
         // Events past the block's end act at its last sample.
         let at = |e: &Timed| (e.timing as usize).min(frames.saturating_sub(1));
         let mut next = events.next();
@@ -451,35 +525,52 @@ impl Instrument {
                                 }
                                 self.apply_voice(i);
                             } else {
-                                self.note_st = note_st;
+                                self.note_key = Some(note);
                                 retuned = true;
                                 strike += response;
+                                // The one model's exciters follow the newest key.
+                                m.held_note = Some((note, channel));
+                                m.strike_hold = 0;
+                                exciters::start(&mut m.gestures, &m.exciters, response);
                             }
                         } else {
                             strike += response;
                         }
                     }
                     Event::NoteOff { note, channel, .. } => {
-                        if let Some(bank) =
-                            self.current.as_deref_mut().and_then(|m| m.bank.as_mut())
-                        {
-                            bank.note_off(note, channel);
+                        if let Some(m) = self.current.as_deref_mut() {
+                            match m.bank.as_mut() {
+                                Some(bank) => bank.note_off(note, channel),
+                                None if m.held_note == Some((note, channel)) => m.held_note = None,
+                                None => {}
+                            }
                         }
                     }
                     Event::Strike { velocity } => {
                         let response = events::velocity_response(velocity, 1.0);
                         let bank = self.current.as_deref_mut().and_then(|m| {
-                            let key = m.settings.reference_key.round().clamp(0.0, 127.0) as u8;
+                            let key = m.home_key().round().clamp(0.0, 127.0) as u8;
                             let note_st = key as f64 - m.settings.reference_key;
                             m.bank.as_mut().map(|b| (b, key, note_st))
                         });
+                        let hold = (exciters::STRIKE_HOLD_MS * 1e-3 * self.sample_rate) as u64;
                         match bank {
-                            // With voices, a strike plays the reference key on a voice.
+                            // With voices, a strike plays the reference key on a voice; its
+                            // exciters hold for a moment, as a short note would.
                             Some((bank, key, note_st)) => {
                                 let i = bank.note_on(key, 0, None, note_st, response);
+                                bank.voices[i].strike_hold = hold.max(1);
                                 self.apply_voice(i);
                             }
-                            None => strike += response,
+                            None => {
+                                strike += response;
+                                if let Some(m) = self.current.as_deref_mut() {
+                                    if m.held_note.is_none() && !m.exciters.is_empty() {
+                                        m.strike_hold = hold.max(1);
+                                        exciters::start(&mut m.gestures, &m.exciters, response);
+                                    }
+                                }
+                            }
                         }
                     }
                     Event::PitchBend { value, channel } => {
@@ -525,8 +616,8 @@ impl Instrument {
                     self.bend_st = events::bend_semitones(value, self.controls.bend_range_st);
                 }
                 Event::NoteOn { note, .. } => {
-                    if let Some(m) = self.current.as_deref().filter(|m| m.bank.is_none()) {
-                        self.note_st = note as f64 - m.settings.reference_key;
+                    if self.current.as_deref().is_some_and(|m| m.bank.is_none()) {
+                        self.note_key = Some(note);
                     }
                 }
                 Event::Controller { cc, value } => {
@@ -571,9 +662,11 @@ impl Instrument {
         }
         let force = self.smoothed.force_gain.value;
         let position = self.smoothed.position_gain.value;
+        let trigger = self.controls.trigger;
         let mut tripped = false;
         if let Some(m) = self.current.as_deref_mut() {
-            m.fill_inputs(&self.host_in, self.order, len, force, position);
+            let fed = m.fill_inputs(&self.host_in, self.order, len, force, position, trigger);
+            m.awake |= fed || self.pressure != 0.0;
             let n_in = m.roles.len();
             let n_out = m.outputs.len() / CHUNK;
             // Pressure: a sustained push on the script's `~pressure` input.
@@ -587,21 +680,35 @@ impl Instrument {
                 }
             }
             let strike_force = m.strike_force(force);
+            let drive = Drive {
+                note_input: m.note_input,
+                strike_force,
+                pressure,
+                exciters: &m.exciters,
+                force: force * m.force_scale,
+                rest_out: &m.rest_out,
+            };
             if let Some(bank) = m.bank.as_mut() {
                 // The model itself keeps playing what the host feeds it (a sidechain strikes
                 // it as without voices); notes play on voices of their own, which hear the
-                // host's inputs too and their own strike.
-                let r =
-                    m.engine
-                        .process(len, &m.inputs[..n_in * len], &mut m.outputs[..n_out * len]);
-                tripped |= r.tripped;
+                // host's inputs too and their own strike. Until the host feeds it, it rests.
+                if m.awake {
+                    let r = m.engine.process(
+                        len,
+                        &m.inputs[..n_in * len],
+                        &mut m.outputs[..n_out * len],
+                    );
+                    tripped |= r.tripped;
+                } else {
+                    for (c, &r) in m.rest_out.iter().enumerate().take(n_out) {
+                        m.outputs[c * len..(c + 1) * len].fill(r);
+                    }
+                }
                 tripped |= bank.process(
                     len,
                     &m.inputs[..n_in * len],
                     &mut m.outputs[..n_out * len],
-                    m.note_input,
-                    strike_force,
-                    pressure,
+                    &drive,
                 );
                 bank.free_silent(len);
                 if let Some(w) = m.watcher.as_mut() {
@@ -614,6 +721,21 @@ impl Instrument {
             } else {
                 if strike > 0.0 {
                     m.strike(0, len, strike, force);
+                }
+                if !m.exciters.is_empty() {
+                    let held = m.held_note.is_some() || m.strike_hold > 0;
+                    m.strike_hold = m.strike_hold.saturating_sub(len as u64);
+                    exciters::play(
+                        &mut m.gestures,
+                        &m.exciters,
+                        held,
+                        self.pressure,
+                        force * m.force_scale,
+                        &mut m.inputs[..n_in * len],
+                        len,
+                        1,
+                        0,
+                    );
                 }
                 // The model.
                 let r =
@@ -640,13 +762,15 @@ impl Instrument {
                 &mut old.outputs[..n_out * len],
             );
             if let Some(bank) = old.bank.as_mut() {
+                let drive = Drive {
+                    rest_out: &old.rest_out,
+                    ..Drive::NONE
+                };
                 bank.process(
                     len,
                     &old.inputs[..n_in * len],
                     &mut old.outputs[..n_out * len],
-                    None,
-                    0.0,
-                    None,
+                    &drive,
                 );
             }
         }

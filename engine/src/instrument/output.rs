@@ -20,12 +20,14 @@ pub(super) struct OutputStage {
 }
 
 /// Host channel `c` of a model's outputs at sample `i` of a chunk of `len`: channel 0 is
-/// `@out1`, channel 1 `@out2` (or `@out1` again for a mono model), channel c `@out(c+1)`.
+/// `@out1`, channel 1 `@out2` (or `@out1` again for a mono model), channel c `@out(c+1)`;
+/// taken off the model's rest output and trimmed ([`super::level`]).
 #[inline]
 pub(super) fn model_channel(m: &Prepared, c: usize, i: usize, len: usize) -> f64 {
     let k = if c == 1 && m.num_outputs == 1 { 0 } else { c };
     if k < m.num_outputs {
-        m.outputs[k * len + i]
+        // Off its rest value, through the automatic trim (0 and 1 in legacy projects).
+        (m.outputs[k * len + i] - m.rest_out[k]) * m.output_trim
     } else {
         0.0
     }

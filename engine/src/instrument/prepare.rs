@@ -4,14 +4,16 @@
 //! buffers). The audio thread then only runs a [`Prepared`] model.
 
 use super::envelope::{envelope, exact_envelope, raw_envelope, worst_load, StabilityEnvelope};
+use super::exciters::{self, Exciter, Gestures};
 use super::host::HostSettings;
 use super::macros::{macro_bindings, MacroBinding};
 use super::units::{unit_of, MacroUnit};
 use super::voices::VoiceBank;
 use super::CHUNK;
+use crate::modes::ModalAnalysis;
 use crate::{
-    compile, parse, CompileOptions, Engine, InputUse, ModelSpec, RouteSource, SampleRateMode,
-    REFERENCE_SAMPLE_RATE_HZ,
+    compile, parse, CompileOptions, Element, ElementKind, Engine, ExciterKind, InputUse, ModelSpec,
+    RouteSource, SampleRateMode, Span, REFERENCE_SAMPLE_RATE_HZ,
 };
 use std::fmt;
 
@@ -77,6 +79,29 @@ pub struct Prepared {
     /// The voices when the model plays polyphonically ([`Prepared::set_voices`]); without
     /// them `engine` is the one voice, and a note retunes it.
     pub bank: Option<VoiceBank>,
+    /// The exciters a key plays besides its strike (`~exciter`, [`super::exciters`]).
+    pub exciters: Vec<Exciter>,
+    /// The one model's gestures (without voices), the key that holds them (note, channel),
+    /// and the samples a strike without a key still holds them.
+    pub gestures: Gestures,
+    pub held_note: Option<(u8, u8)>,
+    pub strike_hold: u64,
+    /// How the model is played: concert pitch and the automatic trims, or as projects saved
+    /// before them.
+    pub conventions: Conventions,
+    /// What each output reads at rest, taken off every copy of the model before the output
+    /// stage, so that a hammer's height or an avatar's position is no step at note-on (0 in
+    /// legacy projects).
+    pub rest_out: Vec<f64>,
+    /// The automatic output trim (linear; the Output Gain knob adds to it) and the trim of
+    /// host force signals (the sidechain), found when the model was prepared
+    /// ([`super::level`]); 1 in legacy projects.
+    pub output_trim: f64,
+    pub input_trim: f64,
+    /// With voices, the model itself plays only what the host feeds it: under today's
+    /// conventions it is not run until a host signal or pressure reaches it (a model that
+    /// moves by itself, a ball dropped at every reset, would otherwise sound at load).
+    pub awake: bool,
 }
 
 /// Why a script did not become the running model: `LINE:COL: error: …` lines.
@@ -129,7 +154,7 @@ pub fn prepare_with(
     name: &str,
     text: &str,
     sample_rate: f64,
-    _conventions: Conventions,
+    conventions: Conventions,
 ) -> Result<Prepared, Rejected> {
     let (spec, settings, _warnings) = parse_script(text)?;
     let mut engine = compile(&spec, &CompileOptions::at(sample_rate))
@@ -147,7 +172,12 @@ pub fn prepare_with(
         })
         .collect();
     let rest = input_rests(&engine);
-    if let Some(k) = settings.note_input {
+    let from_exciter = spec
+        .host
+        .exciters
+        .iter()
+        .any(|e| e.kind == ExciterKind::Strike);
+    if let Some(k) = settings.note_input.filter(|_| !from_exciter) {
         if roles.get(k as usize) != Some(&InputRole::Force) {
             let line = text
                 .lines()
@@ -161,17 +191,42 @@ pub fn prepare_with(
             )]));
         }
     }
+    let exciters = exciters::resolve(&spec, &engine, &roles, sample_rate)?;
     let routing = (0..roles.len())
         .map(|i| settings.routing.get(i).copied().flatten())
         .collect();
-    let note_input = settings
-        .note_input
-        .map(|i| i as usize)
-        .or_else(|| roles.iter().position(|r| *r == InputRole::Force));
+    // A script with exciters strikes only where it says; one without strikes its first force
+    // input.
+    let note_input = settings.note_input.map(|i| i as usize).or_else(|| {
+        (!settings.has_exciters)
+            .then(|| roles.iter().position(|r| *r == InputRole::Force))
+            .flatten()
+    });
 
     let mut settings = settings;
     if settings.reference_pitch_hz.is_none() {
-        settings.reference_pitch_hz = reference_pitch(&mut engine, note_input, &roles);
+        settings.reference_pitch_hz = match conventions {
+            Conventions::Legacy => reference_pitch(&mut engine, note_input, &roles),
+            Conventions::Musical => musical_reference_pitch(
+                &spec,
+                &mut engine,
+                note_input,
+                &exciters,
+                &roles,
+                sample_rate,
+            ),
+        };
+    }
+    // Concert pitch: the key whose equal-tempered pitch (A4 = 440 Hz; the A4 control moves
+    // every key together) is the model's reference pitch. An unpitched model keeps its own
+    // pitch at its `~key`.
+    if conventions == Conventions::Musical && !settings.unpitched {
+        if let Some(f) = settings
+            .reference_pitch_hz
+            .filter(|f| *f > 0.0 && f.is_finite())
+        {
+            settings.reference_key = concert_key(f);
+        }
     }
     // The exact limit where it applies; the Gershgorin envelope (whose scale the macro
     // envelopes share) otherwise.
@@ -202,9 +257,18 @@ pub fn prepare_with(
         SampleRateMode::Raw => 1.0,
     };
     let num_outputs = info.num_outputs();
-    Ok(Prepared {
+    let mut prepared = Prepared {
         watcher: None,
         bank: None,
+        exciters,
+        gestures: exciters::AT_REST,
+        held_note: None,
+        strike_hold: 0,
+        conventions,
+        rest_out: vec![0.0; num_outputs.max(1)],
+        output_trim: 1.0,
+        input_trim: 1.0,
+        awake: conventions == Conventions::Legacy,
         inputs: vec![0.0; roles.len() * CHUNK],
         outputs: vec![0.0; num_outputs.max(1) * CHUNK],
         num_outputs,
@@ -223,7 +287,101 @@ pub fn prepare_with(
         sample_rate,
         name: name.to_string(),
         engine,
-    })
+    };
+    if conventions == Conventions::Musical {
+        prepared = super::level::calibrate(prepared);
+    }
+    Ok(prepared)
+}
+
+/// The MIDI key (fractional) whose equal-tempered pitch is `f` Hz, A4 = 440 Hz at key 69.
+pub fn concert_key(f: f64) -> f64 {
+    69.0 + 12.0 * (f / 440.0).log2()
+}
+
+/// The reference pitch under today's conventions: the mode the modal analysis finds from
+/// where a key excites the model (the strike's input, else the point an exciter's avatar
+/// acts on: the bowed or plucked mass), taken down to its fundamental when it is a harmonic
+/// of a lower mode ([`reference_mode`]). Models the analysis cannot read fall back to the
+/// impulse response, as [`reference_pitch`] does.
+fn musical_reference_pitch(
+    spec: &ModelSpec,
+    engine: &mut Engine,
+    note_input: Option<usize>,
+    exciters: &[Exciter],
+    roles: &[InputRole],
+    sample_rate: f64,
+) -> Option<f64> {
+    if engine.info().num_outputs() == 0 {
+        return None;
+    }
+    if let Some(k) = note_input {
+        let a = engine.modes(None);
+        return reference_mode(&a, k + 1).or_else(|| estimate_pitch(engine, note_input, roles));
+    }
+    if exciters.is_empty() {
+        // Nothing for a key to play: a model that plays by itself from rest (a dropped ball)
+        // is heard by how it sounds then.
+        return free_run_pitch(engine, roles);
+    }
+    // A force where the first bow or plectrum acts, on a copy of the model.
+    let contact = exciters.iter().find_map(|x| x.contact.clone());
+    if let Some(target) = contact {
+        let channel = roles.len() as u32 + 1;
+        let mut probe = spec.clone();
+        probe.elements.push(Element {
+            label: crate::spec::Label::new(format!("in{channel}")),
+            kind: ElementKind::FrcInput { channel, target },
+            buffers: Vec::new(),
+            tag_xy: None,
+            span: Span::default(),
+        });
+        let mut options = CompileOptions::at(sample_rate);
+        options.jit = false;
+        if let Ok(mut e) = compile(&probe, &options) {
+            let a = e.modes(None);
+            return reference_mode(&a, channel as usize);
+        }
+        return None;
+    }
+    // A press on a position or force input: the analysis from that input.
+    let k = exciters
+        .iter()
+        .find(|x| matches!(x.role, InputRole::Force | InputRole::Position))?
+        .input;
+    let a = engine.modes(None);
+    reference_mode(&a, k + 1)
+}
+
+/// The reference mode from `input` (1-based) to `@out1`: the strongest mode above 20 Hz, or
+/// the fundamental of the harmonic series it belongs to. A string's strongest mode at the
+/// listening point is often a higher harmonic; its pitch is its fundamental. The fundamental
+/// is the lowest mode f at most 40 dB weaker than the strongest, such that the strongest lies
+/// within 1 % of a whole multiple n·f (n ≥ 2) and a mode lies within 1 % of 2·f: a series, not
+/// two modes of a membrane that happen to fall near a ratio.
+pub fn reference_mode(a: &ModalAnalysis, input: usize) -> Option<f64> {
+    let strongest = a.strongest(input, 1, 20.0)?;
+    let (fs, gs) = (
+        strongest.frequency_hz,
+        strongest
+            .gains
+            .get((input - 1) * a.num_outputs)
+            .copied()
+            .unwrap_or(0.0),
+    );
+    let near = |f: f64, target: f64| (f - target).abs() <= 0.01 * target;
+    let has_mode = |target: f64| a.modes.iter().any(|m| near(m.frequency_hz, target));
+    for (i, m) in a.modes.iter().enumerate() {
+        let f = m.frequency_hz;
+        if f < 20.0 || f >= fs * 0.99 {
+            continue;
+        }
+        let n = (fs / f).round();
+        if n >= 2.0 && near(fs, n * f) && a.gain(i, input, 1) >= 0.01 * gs && has_mode(2.0 * f) {
+            return Some(f);
+        }
+    }
+    Some(fs)
 }
 
 /// The model's reference pitch (issue 14): the strongest mode that `@out1` hears from the note
@@ -349,6 +507,46 @@ fn estimate_pitch(
     peak_frequency(&signal, sr)
 }
 
+/// Work budget of the free-run pitch, in element-steps, and its longest window.
+const FREE_RUN_BUDGET: f64 = 1e8;
+const FREE_RUN_SECONDS: f64 = 1.0;
+
+/// The pitch of a model that moves by itself from rest (a ball dropped at every reset, as a
+/// voice of Drunk Triangles): the strongest peak of `@out1` over up to a second of it, its
+/// inputs at rest, within [`FREE_RUN_BUDGET`]. The engine is reset afterwards.
+fn free_run_pitch(engine: &mut Engine, roles: &[InputRole]) -> Option<f64> {
+    let info = engine.info();
+    let n_out = info.num_outputs();
+    if n_out == 0 {
+        return None;
+    }
+    let size = (info.num_points + info.num_interactions).max(1) as f64;
+    let sr = engine.sample_rate_hz();
+    let frames = (FREE_RUN_SECONDS * sr).min(FREE_RUN_BUDGET / size) as usize / CHUNK * CHUNK;
+    if frames < 1024 {
+        return None;
+    }
+    let rest = input_rests(engine);
+    let n_in = roles.len();
+    let mut inputs = vec![0.0; n_in * CHUNK];
+    for (k, r) in rest.iter().enumerate().take(n_in) {
+        inputs[k * CHUNK..(k + 1) * CHUNK].fill(*r);
+    }
+    let mut outputs = vec![0.0; n_out * CHUNK];
+    let mut signal = Vec::with_capacity(frames);
+    while signal.len() < frames {
+        engine.process(CHUNK, &inputs, &mut outputs);
+        signal.extend_from_slice(&outputs[..CHUNK]);
+    }
+    let tripped = engine.is_tripped();
+    engine.reset();
+    let first = signal[0];
+    if tripped || signal.iter().all(|v| *v == first) {
+        return None;
+    }
+    peak_frequency(&signal, sr)
+}
+
 /// The frequency of the strongest peak above 20 Hz (Hann window, parabolic interpolation of
 /// the log magnitude).
 pub fn peak_frequency(signal: &[f64], sample_rate: f64) -> Option<f64> {
@@ -396,8 +594,10 @@ impl Prepared {
     /// (`host_in`, indexed as [`super::host::channel`] numbers them). Each model input takes
     /// the channel its `~route` names, else the next of `order`; a position input receives
     /// its rest + signal × `position`, a force input signal × `force` ×
-    /// [`Prepared::force_scale`], an audio-rate parameter the raw signal (the engine adds its
-    /// declared default). An unfed input holds its rest.
+    /// [`Prepared::force_scale`] × [`Prepared::input_trim`] (nothing with `trigger`: the
+    /// sidechain then plays strikes), an audio-rate parameter the raw signal (the engine adds
+    /// its declared default). An unfed input holds its rest. Returns whether a host signal
+    /// reached an input.
     pub fn fill_inputs(
         &mut self,
         host_in: &[[f64; CHUNK]],
@@ -405,11 +605,15 @@ impl Prepared {
         len: usize,
         force: f64,
         position: f64,
-    ) {
+        trigger: bool,
+    ) -> bool {
+        let mut fed = false;
         for (k, role) in self.roles.iter().enumerate() {
             let source = self.routing[k].or_else(|| order.get(k).copied());
             let gain = match role {
-                InputRole::Force => force * self.force_scale,
+                // In trigger mode the host's force signals become strikes instead.
+                InputRole::Force if trigger => 0.0,
+                InputRole::Force => force * self.force_scale * self.input_trim,
                 InputRole::Position => position,
                 InputRole::AudioParam => 1.0,
                 InputRole::Unused => 0.0,
@@ -423,11 +627,13 @@ impl Prepared {
                 Some(channel) if gain != 0.0 => {
                     for (d, s) in dst.iter_mut().zip(&channel[..len]) {
                         *d = rest + s * gain;
+                        fed |= *s != 0.0;
                     }
                 }
                 _ => dst.fill(rest),
             }
         }
+        fed
     }
 
     /// Plays `voices` notes at once: 1 is the monophonic instrument (a note retunes and strikes
@@ -469,6 +675,43 @@ impl Prepared {
     /// the rate scale × `force` (the Force gain).
     pub fn strike_force(&self, force: f64) -> f64 {
         self.settings.note_force * self.strike_scale * force
+    }
+
+    /// The key the model plays before any note, and that a strike without a key (the
+    /// editor's, a sidechain trigger's) plays: C4 for a pitched model in concert pitch, so
+    /// that it sounds where its level was measured ([`super::level`]); the `~key` at which an
+    /// unpitched model (or a legacy project's) sounds as written.
+    pub fn home_key(&self) -> f64 {
+        if self.conventions == Conventions::Musical && !self.settings.unpitched {
+            f64::from(super::level::MEASURE_KEY)
+        } else {
+            self.settings.reference_key
+        }
+    }
+
+    /// The highest key that sounds in tune at default controls: above it the stability
+    /// clamp holds the Stiffness gain a note asks for (the exact law inverted at the
+    /// envelope's largest gain). None without a reference pitch or a limit.
+    pub fn highest_key(&self) -> Option<f64> {
+        let f = self.settings.reference_pitch_hz?;
+        let g = self.envelope.max_stiffness(1.0);
+        if !(g.is_finite() && f > 0.0 && f < 0.49 * self.sample_rate) {
+            return None;
+        }
+        let s = g.sqrt() * (std::f64::consts::PI * f / self.sample_rate).sin();
+        let top = if s >= 1.0 {
+            0.49 * self.sample_rate
+        } else {
+            (self.sample_rate / std::f64::consts::PI * s.asin()).min(0.49 * self.sample_rate)
+        };
+        Some(self.settings.reference_key + 12.0 * (top / f).log2())
+    }
+
+    /// Puts the one model's gestures at rest, with no key holding them.
+    pub fn rest_gestures(&mut self) {
+        self.gestures = exciters::AT_REST;
+        self.held_note = None;
+        self.strike_hold = 0;
     }
 
     /// Adds a one-sample strike of `velocity` (0 … 1) to the note input at `frame` of the

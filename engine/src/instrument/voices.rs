@@ -14,6 +14,7 @@
 //! lies on its triangle, away from where it started).
 
 use super::controls::{Controlled, Gains, TuneKey, TuningMemo};
+use super::exciters::{self, Exciter, Gestures};
 use super::CHUNK;
 use crate::lanes::{LaneEngine, LANES};
 use crate::{Engine, ParamId, ScaleClass};
@@ -77,6 +78,41 @@ pub struct Voice {
     pub tuned: Option<(TuneKey, Gains)>,
     /// The tuning gain of the voice's last pitch (see `Smoothed::gains_offset`).
     pub tuning: TuningMemo,
+    /// The voice's exciter gestures, the velocity response they start with at the voice's next
+    /// span, whether one still moves or holds its input (the voice then stays), and the
+    /// samples a strike without a key (the editor's, a sidechain trigger's) holds them.
+    pub gestures: Gestures,
+    pub onset: Option<f64>,
+    pub sustaining: bool,
+    pub strike_hold: u64,
+}
+
+/// What every voice of a span hears besides the host's inputs: its strike, its pressure and
+/// its exciters.
+#[derive(Clone, Copy, Debug)]
+pub struct Drive<'a> {
+    /// The input a note strikes, and the force of a strike per unit of velocity response.
+    pub note_input: Option<usize>,
+    pub strike_force: f64,
+    /// The `~pressure` input and what full pressure adds to it.
+    pub pressure: Option<(usize, f64)>,
+    pub exciters: &'a [Exciter],
+    /// What a force input's value is multiplied by (the Force Gain, the rate scale).
+    pub force: f64,
+    /// Each output's value at rest, taken off every voice.
+    pub rest_out: &'a [f64],
+}
+
+impl Drive<'_> {
+    /// Nothing but the host's inputs (a model fading out).
+    pub const NONE: Drive<'static> = Drive {
+        note_input: None,
+        strike_force: 0.0,
+        pressure: None,
+        exciters: &[],
+        force: 0.0,
+        rest_out: &[],
+    };
 }
 
 /// A voice that ended, for the host (CLAP voice-terminated events).
@@ -202,6 +238,10 @@ impl VoiceBank {
             strike: 0.0,
             tuned: None,
             tuning: TuningMemo::default(),
+            gestures: exciters::AT_REST,
+            onset: None,
+            sustaining: false,
+            strike_hold: 0,
         };
         VoiceBank {
             voices: vec![voice; capacity],
@@ -362,6 +402,10 @@ impl VoiceBank {
         v.fade_step = 0.0;
         v.strike = strike;
         v.tuned = None;
+        v.gestures = exciters::AT_REST;
+        v.onset = Some(strike);
+        v.sustaining = false;
+        v.strike_hold = 0;
         slot
     }
 
@@ -479,19 +523,15 @@ impl VoiceBank {
     }
 
     /// Runs one span of `len` samples: every voice that is not free hears `inputs` (the
-    /// model's planar input scratch) plus its own strike, and the voices' outputs are added
-    /// to `outputs` (planar, `n_out` channels). A strike enters the note input × `strike_force`.
-    /// Returns whether a voice's guard tripped (that voice is freed).
-    /// A voice's pressure adds `pressure × pressure_gain` to input `pressure_input` at every
-    /// sample (the script's `~pressure`).
+    /// model's planar input scratch) plus its own strike, pressure and exciters ([`Drive`]),
+    /// and the voices' outputs, off their rest values, are added to `outputs` (planar, `n_out`
+    /// channels). Returns whether a voice's guard tripped (that voice is freed).
     pub fn process(
         &mut self,
         len: usize,
         inputs: &[f64],
         outputs: &mut [f64],
-        note_input: Option<usize>,
-        strike_force: f64,
-        pressure: Option<(usize, f64)>,
+        drive: &Drive<'_>,
     ) -> bool {
         let n_in = inputs.len() / len.max(1);
         let n_out = outputs.len() / len.max(1);
@@ -506,16 +546,7 @@ impl VoiceBank {
                     }
                     let vin = &mut self.inputs[..inputs.len()];
                     vin.copy_from_slice(inputs);
-                    voice_inputs(
-                        &mut self.voices[i],
-                        vin,
-                        len,
-                        1,
-                        0,
-                        note_input,
-                        strike_force,
-                        pressure,
-                    );
+                    voice_inputs(&mut self.voices[i], vin, len, 1, 0, drive);
                     let vout = &mut self.outputs[..outputs.len()];
                     let report = engines[i].process(len, vin, vout);
                     if report.tripped || engines[i].is_tripped() {
@@ -523,7 +554,7 @@ impl VoiceBank {
                         self.end(i);
                         continue;
                     }
-                    self.mix(i, len, n_out, 1, 0, outputs);
+                    self.mix(i, len, n_out, 1, 0, outputs, drive.rest_out);
                 }
             }
             Copies::Lanes(groups) => {
@@ -542,16 +573,7 @@ impl VoiceBank {
                         vin[k * LANES..(k + 1) * LANES].fill(*x);
                     }
                     for i in first..last {
-                        voice_inputs(
-                            &mut self.voices[i],
-                            vin,
-                            len,
-                            LANES,
-                            i - first,
-                            note_input,
-                            strike_force,
-                            pressure,
-                        );
+                        voice_inputs(&mut self.voices[i], vin, len, LANES, i - first, drive);
                     }
                     let vout = &mut self.outputs[..n_out * len * LANES];
                     let lane_tripped = group.process(len, vin, vout);
@@ -567,17 +589,21 @@ impl VoiceBank {
                             continue;
                         }
                         if self.voices[i].state == VoiceState::Fading {
-                            self.mix(i, len, n_out, LANES, l, outputs);
+                            self.mix(i, len, n_out, LANES, l, outputs, drive.rest_out);
                         } else {
                             sounding[l] = true;
                         }
                     }
                     let mixed = &mut self.mixed[..n_out * len * LANES];
                     let vout = &self.outputs[..n_out * len * LANES];
-                    for (sum, frame) in mixed.chunks_exact_mut(LANES).zip(vout.chunks_exact(LANES))
+                    for (f, (sum, frame)) in mixed
+                        .chunks_exact_mut(LANES)
+                        .zip(vout.chunks_exact(LANES))
+                        .enumerate()
                     {
+                        let rest = drive.rest_out.get(f / len).copied().unwrap_or(0.0);
                         for l in 0..LANES {
-                            sum[l] += if sounding[l] { frame[l] } else { 0.0 };
+                            sum[l] += if sounding[l] { frame[l] - rest } else { 0.0 };
                         }
                     }
                 }
@@ -594,8 +620,9 @@ impl VoiceBank {
         tripped
     }
 
-    /// Adds voice `i`'s outputs (lane `lane` of `width` in the scratch) to `outputs`, fading
-    /// a stolen voice out and freeing it at the end of its fade.
+    /// Adds voice `i`'s outputs (lane `lane` of `width` in the scratch), off their `rest`
+    /// values, to `outputs`, fading a stolen voice out and freeing it at the end of its fade.
+    #[allow(clippy::too_many_arguments)]
     fn mix(
         &mut self,
         i: usize,
@@ -604,23 +631,28 @@ impl VoiceBank {
         width: usize,
         lane: usize,
         outputs: &mut [f64],
+        rest: &[f64],
     ) {
         let v = &mut self.voices[i];
         let src = &self.outputs;
+        let rest_of = |c: usize| rest.get(c).copied().unwrap_or(0.0);
         if v.state == VoiceState::Fading {
             for n in 0..len {
                 v.gain -= v.fade_step;
                 let g = v.gain.max(0.0);
                 for c in 0..n_out {
-                    outputs[c * len + n] += src[(c * len + n) * width + lane] * g;
+                    outputs[c * len + n] += (src[(c * len + n) * width + lane] - rest_of(c)) * g;
                 }
             }
             if v.gain <= 0.0 {
                 v.state = VoiceState::Free;
             }
         } else {
-            for (k, o) in outputs[..n_out * len].iter_mut().enumerate() {
-                *o += src[k * width + lane];
+            for c in 0..n_out {
+                let r = rest_of(c);
+                for (n, o) in outputs[c * len..(c + 1) * len].iter_mut().enumerate() {
+                    *o += src[(c * len + n) * width + lane] - r;
+                }
             }
         }
     }
@@ -631,31 +663,52 @@ fn group(g: usize, voices: usize) -> std::ops::Range<usize> {
     g * LANES..(g * LANES + LANES).min(voices)
 }
 
-/// Adds voice `v`'s strike (on the note input's first sample) and pressure (on every sample of
-/// the `~pressure` input) to lane `lane` of `width` of the planar inputs `vin`, and consumes
-/// the strike.
-#[allow(clippy::too_many_arguments)]
+/// Adds voice `v`'s strike (on the note input's first sample), pressure (on every sample of
+/// the `~pressure` input) and exciter gestures to lane `lane` of `width` of the planar inputs
+/// `vin`, and consumes the strike.
 fn voice_inputs(
     v: &mut Voice,
     vin: &mut [f64],
     len: usize,
     width: usize,
     lane: usize,
-    note_input: Option<usize>,
-    strike_force: f64,
-    pressure: Option<(usize, f64)>,
+    drive: &Drive<'_>,
 ) {
     let n_in = vin.len() / (len * width).max(1);
     if v.state == VoiceState::Free {
         return;
     }
     if v.strike != 0.0 {
-        if let Some(k) = note_input.filter(|k| *k < n_in) {
-            vin[k * len * width + lane] += v.strike * strike_force;
+        if let Some(k) = drive.note_input.filter(|k| *k < n_in) {
+            vin[k * len * width + lane] += v.strike * drive.strike_force;
         }
         v.strike = 0.0;
     }
-    if let Some((k, gain)) = pressure.filter(|(k, _)| *k < n_in) {
+    if !drive.exciters.is_empty() {
+        if let Some(level) = v.onset.take() {
+            exciters::start(&mut v.gestures, drive.exciters, level);
+        }
+        if v.strike_hold > 0 {
+            v.strike_hold = v.strike_hold.saturating_sub(len as u64);
+            if v.strike_hold == 0 && v.state == VoiceState::Held {
+                v.state = VoiceState::Released;
+            }
+        }
+        let held = v.state == VoiceState::Held;
+        exciters::play(
+            &mut v.gestures,
+            drive.exciters,
+            held,
+            v.pressure,
+            drive.force,
+            vin,
+            len,
+            width,
+            lane,
+        );
+        v.sustaining = exciters::busy(&v.gestures, drive.exciters, held);
+    }
+    if let Some((k, gain)) = drive.pressure.filter(|(k, _)| *k < n_in) {
         let add = v.pressure * gain;
         if add != 0.0 {
             for n in 0..len {
@@ -683,7 +736,12 @@ mod tests {
         let mut outputs = [0.0; CHUNK];
         for _ in 0..spans {
             outputs.fill(0.0);
-            bank.process(CHUNK, &inputs, &mut outputs, Some(0), 1.0, None);
+            let drive = Drive {
+                note_input: Some(0),
+                strike_force: 1.0,
+                ..Drive::NONE
+            };
+            bank.process(CHUNK, &inputs, &mut outputs, &drive);
         }
     }
 

@@ -46,7 +46,7 @@ mod symbols;
 pub use diagnostics::{Diagnostic, DiagnosticCode, Severity, MAX_DIAGNOSTICS};
 pub use expr_parser::MAX_NESTING;
 pub use generate::MAX_GENERATED_ELEMENTS;
-pub use parser::{parse, parse_bytes, MAX_MACRO_NODES, MAX_OPEN_SCOPES};
+pub use parser::{parse, parse_bytes, MAX_EXCITERS, MAX_MACRO_NODES, MAX_OPEN_SCOPES};
 pub use printer::print;
 
 use crate::spec::ModelSpec;

@@ -40,6 +40,8 @@ pub const MAX_MACRO_NODES: u64 = 1 << 20;
 /// bounds memory on absurd input; real scripts open a handful.
 pub const MAX_OPEN_SCOPES: usize = 64;
 
+pub use directives::MAX_EXCITERS;
+
 /// Parses script text (spec §3). See [`Parsed`].
 pub fn parse(text: &str) -> Parsed {
     parse_with(text, Diags::default())

@@ -428,6 +428,19 @@ pub fn print(spec: &ModelSpec) -> String {
             }
         }
     }
+    if h.unpitched {
+        out.push_str("~unpitched\n");
+    }
+    for e in &h.exciters {
+        let _ = write!(out, "~exciter in{} {}", e.input, e.kind.name());
+        if let Some(a) = e.amount {
+            let _ = write!(out, " {}", format_number(a));
+            if let Some(t) = e.time_ms {
+                let _ = write!(out, " {}", format_number(t));
+            }
+        }
+        out.push('\n');
+    }
     for r in &h.routes {
         let _ = writeln!(out, "~route in{} {}", r.input, r.source.name());
     }

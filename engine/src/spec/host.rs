@@ -1,5 +1,8 @@
 //! How a host plays a model: the host directives (`~pitch`, `~key`, `~note`, `~route`,
-//! `~macro`, `~voices`, `~pressure`) as the spec keeps them. The engine ignores them.
+//! `~macro`, `~voices`, `~pressure`, `~exciter`, `~unpitched`) as the spec keeps them. The
+//! engine ignores them.
+
+use super::Span;
 
 /// A host channel a model input can be routed to (`~route inK SOURCE`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,6 +85,58 @@ pub struct MacroRange {
     pub max: f64,
 }
 
+/// What a key does to a model input (`~exciter inK KIND …`, docs/LANGUAGE.md §12.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ExciterKind {
+    /// A one-sample force impulse at note-on (today's `~note`).
+    Strike,
+    /// A held key moves the input at a steady speed, set by velocity; the speed rises and
+    /// falls over a ramp at note-on and note-off.
+    Bow,
+    /// Key-down sweeps the input across to the other side of its rest, once.
+    Pluck,
+    /// A held key pushes the input to a depth and lets it back at note-off.
+    Press,
+}
+
+impl ExciterKind {
+    pub const ALL: [ExciterKind; 4] = [
+        ExciterKind::Strike,
+        ExciterKind::Bow,
+        ExciterKind::Pluck,
+        ExciterKind::Press,
+    ];
+
+    /// The script's word for the kind.
+    pub fn name(self) -> &'static str {
+        match self {
+            ExciterKind::Strike => "strike",
+            ExciterKind::Bow => "bow",
+            ExciterKind::Pluck => "pluck",
+            ExciterKind::Press => "press",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<ExciterKind> {
+        ExciterKind::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// `~exciter inK KIND [AMOUNT [TIME_MS]]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExciterDecl {
+    /// 1-based model input channel.
+    pub input: u32,
+    pub kind: ExciterKind,
+    /// The strike's force, the bow's speed (units/s), the pluck's travel, the press's depth;
+    /// None takes the default the model's laws give.
+    pub amount: Option<f64>,
+    /// The bow's and the press's ramp, the pluck's sweep, in milliseconds.
+    pub time_ms: Option<f64>,
+    /// Where the directive stands, for the errors found when the model is prepared.
+    pub span: Span,
+}
+
 /// How a host plays the model. Every field is optional; a host uses its defaults.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct HostSpec {
@@ -103,4 +158,9 @@ pub struct HostSpec {
     /// pressure adds to it.
     pub pressure_input: Option<u32>,
     pub pressure_scale: Option<f64>,
+    /// `~exciter` lines, in script order.
+    pub exciters: Vec<ExciterDecl>,
+    /// `~unpitched`: the model keeps its own pitch at its `~key` instead of playing in
+    /// concert pitch.
+    pub unpitched: bool,
 }

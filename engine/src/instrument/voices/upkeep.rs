@@ -31,8 +31,8 @@ impl VoiceBank {
             if !matches!(v.state, VoiceState::Held | VoiceState::Released) {
                 continue;
             }
-            if v.pressure > 0.0 {
-                // A key that still presses drives its voice: it stays.
+            if v.pressure > 0.0 || v.sustaining {
+                // A key that still presses drives its voice, a bow still bows: it stays.
                 v.quiet = 0;
                 continue;
             }

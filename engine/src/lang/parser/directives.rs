@@ -1,5 +1,6 @@
 //! Directives (spec §3.10, §3.11): `~begin`, `~end`, `~samplerate`, and the host directives
-//! `~pitch`, `~key`, `~note`, `~route`, `~macro`.
+//! `~pitch`, `~key`, `~note`, `~route`, `~macro`, `~voices`, `~pressure`, `~exciter`,
+//! `~unpitched`.
 
 use super::lines::Item;
 use super::{At, Builder, MAX_OPEN_SCOPES};
@@ -7,10 +8,16 @@ use crate::lang::diagnostics::{DiagnosticCode, Diags};
 use crate::lang::expr_parser::is_identifier;
 use crate::lang::lexer::{TokKind, Token};
 use crate::lang::symbols::SymKind;
-use crate::spec::{MacroRange, Route, RouteSource, SampleRateMode};
+use crate::spec::{ExciterDecl, ExciterKind, MacroRange, Route, RouteSource, SampleRateMode, Span};
 
 /// The highest model input a host directive may name.
 const MAX_HOST_INPUT: u32 = 64;
+
+/// The most `~exciter` lines a script may have (a voice keeps their state in place).
+pub const MAX_EXCITERS: usize = 8;
+
+/// The longest exciter ramp or sweep, in milliseconds.
+const MAX_EXCITER_MS: f64 = 2000.0;
 
 fn plural_args(count: &[usize]) -> String {
     match count {
@@ -36,7 +43,15 @@ impl Builder<'_> {
         };
         if matches!(
             name,
-            "pitch" | "key" | "note" | "route" | "macro" | "voices" | "pressure"
+            "pitch"
+                | "key"
+                | "note"
+                | "route"
+                | "macro"
+                | "voices"
+                | "pressure"
+                | "exciter"
+                | "unpitched"
         ) {
             self.host_directive(item, name, first.col, args);
             return;
@@ -53,7 +68,7 @@ impl Builder<'_> {
                     )
                     .with_expected(
                         "~begin, ~end, ~samplerate, ~generate, ~pitch, ~key, ~note, ~route, \
-                         ~macro, ~voices or ~pressure",
+                         ~macro, ~voices, ~pressure, ~exciter or ~unpitched",
                     )
                     .with_found(format!("~{name}")),
                 );
@@ -195,6 +210,12 @@ impl Builder<'_> {
                 "an input (`in1`…) and optionally the force of a full-velocity note",
                 &[1, 2],
             ),
+            "exciter" => (
+                "an input (`in1`…), a kind (strike, bow, pluck or press), then optionally its \
+                 amount and its time in ms",
+                &[2, 3, 4],
+            ),
+            "unpitched" => ("no argument", &[0]),
             "route" => (
                 "an input (`in1`…) and main_left, main_right, sidechain_left, sidechain_right, \
                  sidechain_3 … sidechain_8 or none",
@@ -247,8 +268,9 @@ impl Builder<'_> {
                 format!("a second `~{name}` for {what}"),
             ));
         };
-        // `~note`, `~route` and `~pressure` start with an input (`@in1` reads as `in1`).
-        let k = if matches!(name, "note" | "route" | "pressure") {
+        // `~note`, `~route`, `~pressure` and `~exciter` start with an input (`@in1` reads as
+        // `in1`).
+        let k = if matches!(name, "note" | "route" | "pressure" | "exciter") {
             let Some(k) = input(&args[0]) else {
                 bad(
                     &mut self.diags,
@@ -327,9 +349,27 @@ impl Builder<'_> {
                     conflict(&mut self.diags, "the model");
                     return;
                 }
+                if name == "note" && host.exciters.iter().any(|e| e.kind == ExciterKind::Strike) {
+                    self.diags.push(at.diag(
+                        DiagnosticCode::ConflictingDirective,
+                        col,
+                        "`~note` and `~exciter … strike` both choose the input a note strikes: \
+                         keep one"
+                            .to_string(),
+                    ));
+                    return;
+                }
                 *input = Some(k);
                 *value = amount;
             }
+            "unpitched" => {
+                if host.unpitched {
+                    conflict(&mut self.diags, "the model");
+                    return;
+                }
+                host.unpitched = true;
+            }
+            "exciter" => self.exciter(item, col, k, args),
             "route" => {
                 let Some(source) = RouteSource::from_name(&args[1].string()) else {
                     bad(
@@ -398,6 +438,112 @@ impl Builder<'_> {
                 });
             }
         }
+    }
+}
+
+impl Builder<'_> {
+    /// `~exciter inK KIND [AMOUNT [TIME_MS]]` (docs/LANGUAGE.md §12.4): what a key does to
+    /// input K. Whether the input can take the kind (a strike needs a force input, a bow or a
+    /// pluck a position input) is checked when the model is prepared, where the inputs are
+    /// known.
+    fn exciter(&mut self, item: &Item, col: u32, k: u32, args: &[Token]) {
+        let at = At {
+            line: item.line,
+            label: None,
+        };
+        let kinds = "strike, bow, pluck or press";
+        let kind_text = args[1].string();
+        let Some(kind) = ExciterKind::from_name(&kind_text) else {
+            self.diags.push(
+                at.diag(
+                    DiagnosticCode::InvalidDirectiveArgument,
+                    args[1].col,
+                    format!("unknown exciter `{kind_text}`"),
+                )
+                .with_expected(kinds)
+                .with_found(kind_text),
+            );
+            return;
+        };
+        let number = |t: &Token| t.string().parse::<f64>().ok().filter(|v| v.is_finite());
+        let mut values = [None, None];
+        for (i, t) in args[2..].iter().enumerate() {
+            let what = if i == 0 {
+                match kind {
+                    ExciterKind::Strike => "the strike's force, a non-zero number",
+                    ExciterKind::Bow => "the bow's speed in units per second, a positive number",
+                    ExciterKind::Pluck => "the plectrum's travel, a positive number",
+                    ExciterKind::Press => "the press's depth, a non-zero number",
+                }
+            } else {
+                match kind {
+                    ExciterKind::Strike => "nothing: a strike takes only its force",
+                    ExciterKind::Bow | ExciterKind::Press => "the ramp in milliseconds, 0 to 2000",
+                    ExciterKind::Pluck => "the sweep in milliseconds, above 0 and up to 2000",
+                }
+            };
+            let ok = number(t).filter(|v| match (i, kind) {
+                (0, ExciterKind::Bow | ExciterKind::Pluck) => *v > 0.0,
+                (0, _) => *v != 0.0,
+                (_, ExciterKind::Strike) => false,
+                (_, ExciterKind::Pluck) => *v > 0.0 && *v <= MAX_EXCITER_MS,
+                _ => (0.0..=MAX_EXCITER_MS).contains(v),
+            });
+            match ok {
+                Some(v) => values[i] = Some(v),
+                None => {
+                    self.diags.push(
+                        at.diag(
+                            DiagnosticCode::InvalidDirectiveArgument,
+                            t.col,
+                            format!(
+                                "`~exciter in{k} {}`: bad value `{}`",
+                                kind.name(),
+                                t.source()
+                            ),
+                        )
+                        .with_expected(what)
+                        .with_found(t.source()),
+                    );
+                    return;
+                }
+            }
+        }
+        let host = &self.spec.host;
+        let conflict = if host.exciters.iter().any(|e| e.input == k) {
+            Some(format!("a second `~exciter` for in{k}"))
+        } else if kind == ExciterKind::Strike
+            && (host.note_input.is_some()
+                || host.exciters.iter().any(|e| e.kind == ExciterKind::Strike))
+        {
+            Some(
+                "a second strike: `~note` and `~exciter … strike` choose the one input a note \
+                 strikes"
+                    .to_string(),
+            )
+        } else {
+            None
+        };
+        if let Some(message) = conflict {
+            self.diags
+                .push(at.diag(DiagnosticCode::ConflictingDirective, col, message));
+            return;
+        }
+        if host.exciters.len() >= MAX_EXCITERS {
+            self.diags.push(at.diag(
+                DiagnosticCode::TooLarge,
+                col,
+                format!("more than {MAX_EXCITERS} exciters"),
+            ));
+            return;
+        }
+        self.spec.host.exciters.push(ExciterDecl {
+            input: k,
+            kind,
+            amount: values[0],
+            time_ms: values[1],
+            span: Span::new(item.line, args[0].col),
+        });
     }
 }
 

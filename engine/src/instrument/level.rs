@@ -1,0 +1,182 @@
+//! Automatic levels: every model sounds at one loudness without touching a knob, and a drum
+//! on the sidechain strikes it as hard as a medium note.
+//!
+//! When a model is prepared (today's conventions; legacy projects keep their own levels) the
+//! instrument plays it offline, off the audio thread, through its own signal path (tuning,
+//! exciters, stability clamp, DC filter):
+//!
+//! 1. **Rest.** What every output reads at rest ([`Prepared::rest_out`]): a hammer's height,
+//!    an avatar's position. It is taken off each copy of the model before the output stage, so
+//!    that a voice's note-on is no step of the hammer's height into the output.
+//! 2. **A note**: C4 at velocity 0.8 ([`MEASURE_KEY`], [`MEASURE_VELOCITY`]), held for the
+//!    render, the peak of every output measured (the main pair and the auxiliary ones). The output trim puts that peak at
+//!    [`TARGET_DBFS`]; Output Gain (0 dB by default) adds to it. Velocity still scales the
+//!    strike, so softer notes stay softer.
+//! 3. **A drum**: a reference kick on the sidechain's first two channels, peaking at
+//!    [`REFERENCE_DRUM_DBFS`] (a sine gliding 150 → 45 Hz under an 80 ms decay), played as raw
+//!    force on the model's force inputs. The input trim of host force signals makes its answer
+//!    peak as high as the note did, so a normal drum strikes like a medium note and a hot one
+//!    stays below the ceiling. Force Gain (0 dB) adds to it. Models whose force inputs the
+//!    sidechain does not feed keep 0 dB.
+//!
+//! A render is at most [`SECONDS`] long (twice that for models with a bow or a press, which
+//! build up), shortened for large models to [`WORK_BUDGET`] element-steps (the 150 × 150 plate
+//! gets 3,000 samples, its peak comes after about 1,400). A model silent from the note takes
+//! its level from the drum; a model silent from both keeps 0 dB.
+
+use super::controls::Controls;
+use super::events::{Event, Timed};
+use super::prepare::Prepared;
+use super::{Instrument, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS};
+use crate::ExciterKind;
+
+/// Where the automatic trim puts a C4 note at velocity 0.8.
+pub const TARGET_DBFS: f64 = -12.0;
+/// The note the level is measured with.
+pub const MEASURE_KEY: u8 = 60;
+pub const MEASURE_VELOCITY: f32 = 0.8;
+/// The peak of the reference drum hits.
+pub const REFERENCE_DRUM_DBFS: f64 = -6.0;
+/// The longest level render, in seconds (doubled with bows and presses).
+pub const SECONDS: f64 = 0.6;
+/// The longest drum render.
+const DRUM_SECONDS: f64 = 0.3;
+/// Element-steps (points + interactions, times samples) a render may take.
+pub const WORK_BUDGET: f64 = 2e8;
+/// The output gain the renders are measured at, far below the soft ceiling's knee.
+const MEASURE_GAIN_DB: f64 = -60.0;
+/// The trims stay within these (linear).
+const OUTPUT_TRIM_RANGE: (f64, f64) = (1e-3, 1e5);
+const INPUT_TRIM_RANGE: (f64, f64) = (1e-5, 1e3);
+/// Below this the model counts as silent.
+const SILENT: f64 = 1e-12;
+
+/// Measures the model's rest outputs, note level and drum level, and sets its trims.
+pub fn calibrate(p: Prepared) -> Prepared {
+    let mut p = p;
+    p.rest_out = rest_outputs(&mut p);
+    let size = (p.engine.info().num_points + p.engine.info().num_interactions).max(1) as f64;
+    let budget = (WORK_BUDGET / size).max(1.0);
+    let held = p
+        .exciters
+        .iter()
+        .any(|x| matches!(x.kind, ExciterKind::Bow | ExciterKind::Press));
+    let sr = p.sample_rate;
+    let note_frames = (SECONDS * if held { 2.0 } else { 1.0 } * sr).min(budget) as usize;
+    let drum_frames = (DRUM_SECONDS * sr).min(budget) as usize;
+    let (p1, note) = peak(p, note_frames, true, None);
+    // The drum, when the sidechain pushes a force input.
+    let (mut p3, drum) = if super::force_channels(&p1, super::host::default_order(false)) != 0 {
+        let kick = kick(drum_frames, sr);
+        peak(p1, drum_frames, false, Some(&kick))
+    } else {
+        (p1, 0.0)
+    };
+    let target = 10f64.powf(TARGET_DBFS / 20.0);
+    let (output, input) = if note > SILENT {
+        (target / note, if drum > SILENT { note / drum } else { 1.0 })
+    } else if drum > SILENT {
+        (target / drum, 1.0)
+    } else {
+        (1.0, 1.0)
+    };
+    p3.output_trim = output.clamp(OUTPUT_TRIM_RANGE.0, OUTPUT_TRIM_RANGE.1);
+    p3.input_trim = input.clamp(INPUT_TRIM_RANGE.0, INPUT_TRIM_RANGE.1);
+    p3
+}
+
+/// Each output's value after one step from rest with every input at rest.
+fn rest_outputs(p: &mut Prepared) -> Vec<f64> {
+    let n_in = p.roles.len();
+    let n_out = p.num_outputs;
+    let mut inputs = vec![0.0; n_in];
+    inputs.copy_from_slice(&p.rest[..n_in]);
+    let mut outputs = vec![0.0; n_out.max(1)];
+    p.engine.process(1, &inputs, &mut outputs[..n_out]);
+    let tripped = p.engine.is_tripped();
+    p.engine.reset();
+    if tripped || outputs.iter().any(|v| !v.is_finite()) {
+        return vec![0.0; n_out.max(1)];
+    }
+    outputs
+}
+
+/// Plays the model for `frames` samples from rest, with the measuring note at the first
+/// sample (`note`) and `drum` on the sidechain's first two channels, and returns it at rest
+/// with the peak of its outputs (the main pair and the auxiliary ones) at unit gain.
+fn peak(p: Prepared, frames: usize, note: bool, drum: Option<&[f32]>) -> (Prepared, f64) {
+    let sr = p.sample_rate;
+    let controls = Controls {
+        output_db: MEASURE_GAIN_DB,
+        ..Controls::DEFAULT
+    };
+    let mut inst = Instrument::new(sr, controls);
+    inst.set_model(Box::new(p));
+    const BLOCK: usize = 256;
+    // Every output the host can hear: the main pair and the auxiliary ones.
+    let channels = match inst.model().map_or(1, |m| m.num_outputs) {
+        0..=2 => 2,
+        n => n.min(MAX_HOST_OUTPUTS).div_ceil(2) * 2,
+    };
+    let mut buffers = [[0.0f32; BLOCK]; MAX_HOST_OUTPUTS];
+    let mut loudest = 0.0f32;
+    let mut done = 0;
+    while done < frames {
+        let len = BLOCK.min(frames - done);
+        let first = done == 0 && note;
+        let mut events =
+            std::iter::once(Timed::new(0, Event::note_on(MEASURE_KEY, MEASURE_VELOCITY)))
+                .filter(|_| first);
+        let mut host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+        if let Some(d) = drum {
+            host[2] = d.get(done..);
+            host[3] = d.get(done..);
+        }
+        let mut out: [&mut [f32]; MAX_HOST_OUTPUTS] = buffers.each_mut().map(|b| &mut b[..len]);
+        inst.process(
+            len,
+            &host,
+            false,
+            &mut events,
+            &controls,
+            &mut out[..channels],
+        );
+        for b in &buffers[..channels] {
+            for s in &b[..len] {
+                loudest = loudest.max(s.abs());
+            }
+        }
+        done += len;
+    }
+    let [current, _, _] = inst.take_models();
+    let mut p = *current.expect("the instrument keeps the model it plays");
+    p.engine.reset();
+    p.rest_gestures();
+    let gain = 10f64.powf(MEASURE_GAIN_DB / 20.0);
+    (p, loudest as f64 / gain)
+}
+
+/// The reference kick: a sine gliding from 150 to 45 Hz (30 ms) under an 80 ms decay,
+/// peaking at [`REFERENCE_DRUM_DBFS`].
+pub fn kick(frames: usize, sample_rate: f64) -> Vec<f32> {
+    let mut phase = 0.0f64;
+    let raw: Vec<f64> = (0..frames)
+        .map(|n| {
+            let t = n as f64 / sample_rate;
+            let f = 45.0 + 105.0 * (-t / 0.03).exp();
+            phase += std::f64::consts::TAU * f / sample_rate;
+            (-t / 0.08).exp() * phase.sin()
+        })
+        .collect();
+    normalized(&raw)
+}
+
+fn normalized(raw: &[f64]) -> Vec<f32> {
+    let peak = raw.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let scale = if peak > 0.0 {
+        10f64.powf(REFERENCE_DRUM_DBFS / 20.0) / peak
+    } else {
+        0.0
+    };
+    raw.iter().map(|v| (v * scale) as f32).collect()
+}
