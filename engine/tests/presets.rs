@@ -367,13 +367,23 @@ fn canonical_scripts_equal_the_builder_reference_models() {
         parsed.host = Default::default();
         let mut spec = spec;
         if file == "hammer-oscillator.mdl" {
-            // The preset leaves out the tutorial's second output, the hammer's height: an
-            // instrument listens to what sounds.
+            // The preset leaves out the tutorial's second output, the hammer's height (an
+            // instrument listens to what sounds), and adds a force on the oscillator for the
+            // sidechain.
             spec.elements.retain(|e| e.label != "out2");
+            parsed.elements.retain(|e| e.label != "in2");
         }
         assert_eq!(parsed, spec, "{file} differs from the builder model");
     }
 }
+
+/// The inputs a preset adds to its gallery model for the plugin's sidechain (a force on the
+/// structure where the hammer strikes: the hammers rest in a catch that an oscillating push
+/// mostly lifts).
+const SIDECHAIN_INPUTS: &[(&str, &str)] = &[
+    ("fretted-string.mdl", "in16"),
+    ("chladni-150x150.mdl", "in7"),
+];
 
 #[test]
 fn gallery_scripts_equal_the_builder_reference_models() {
@@ -384,6 +394,11 @@ fn gallery_scripts_equal_the_builder_reference_models() {
         let mut parsed = preset(file);
         // The host directives (`~voices`, …) are the plugin's; the physics is the builder's.
         parsed.host = Default::default();
+        for (f, label) in SIDECHAIN_INPUTS {
+            if f == &file {
+                parsed.elements.retain(|e| e.label != *label);
+            }
+        }
         // Element by element first, for a readable failure on a 200-line model.
         for (i, (a, b)) in parsed.elements.iter().zip(&spec.elements).enumerate() {
             assert_eq!(a, b, "{file}: element {i} differs from the builder model");

@@ -12,15 +12,16 @@
 //!    render, the peak of every output measured (the main pair and the auxiliary ones). The output trim puts that peak at
 //!    [`TARGET_DBFS`]; Output Gain (0 dB by default) adds to it. Velocity still scales the
 //!    strike, so softer notes stay softer.
-//! 3. **A drum**: a reference kick on the sidechain's first two channels, peaking at
-//!    [`REFERENCE_DRUM_DBFS`] (a sine gliding 150 → 45 Hz under an 80 ms decay), played as raw
-//!    force on the model's force inputs. The input trim of host force signals makes its answer
-//!    peak as high as the note did, so a normal drum strikes like a medium note and a hot one
-//!    stays below the ceiling. Force Gain (0 dB) adds to it. Models whose force inputs the
-//!    sidechain does not feed keep 0 dB.
+//! 3. **A drum**: a reference kick on the sidechain channels that feed the model, peaking at [`REFERENCE_DRUM_DBFS`] (a sine gliding 150 → 45
+//!    Hz under an 80 ms decay). The input trim of the host signals that push the model (on its
+//!    force and position inputs) makes its answer peak as high as the note did, so a normal drum strikes like a medium note and a hot one stays
+//!    below the ceiling. Force and Position Gain (0 dB) add to it. Models the sidechain does
+//!    not push keep 0 dB. A hammer between the input and the model makes the
+//!    answer far from proportional (a weak push presses the hammer onto a plate, or does not
+//!    reach the string at all), so the trim is checked by playing the kick through it and
+//!    corrected until the two peaks agree within 2 dB (at most four more renders).
 //!
-//! A render is at most [`SECONDS`] long (twice that for models with a bow or a press, which
-//! build up), shortened for large models to [`WORK_BUDGET`] element-steps (the 150 × 150 plate
+//! A render is at most [`SECONDS`] long, shortened for large models to [`WORK_BUDGET`] element-steps (the 150 × 150 plate
 //! gets 3,000 samples, its peak comes after about 1,400). A model silent from the note takes
 //! its level from the drum; a model silent from both keeps 0 dB.
 
@@ -28,7 +29,6 @@ use super::controls::Controls;
 use super::events::{Event, Timed};
 use super::prepare::Prepared;
 use super::{Instrument, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS};
-use crate::ExciterKind;
 
 /// Where the automatic trim puts a C4 note at velocity 0.8.
 pub const TARGET_DBFS: f64 = -12.0;
@@ -37,8 +37,9 @@ pub const MEASURE_KEY: u8 = 60;
 pub const MEASURE_VELOCITY: f32 = 0.8;
 /// The peak of the reference drum hits.
 pub const REFERENCE_DRUM_DBFS: f64 = -6.0;
-/// The longest level render, in seconds (doubled with bows and presses).
-pub const SECONDS: f64 = 0.6;
+/// The longest level render, in seconds: a bow builds up over a second, and a bouncing ball
+/// can pass its energy on for as long.
+pub const SECONDS: f64 = 1.5;
 /// The longest drum render.
 const DRUM_SECONDS: f64 = 0.3;
 /// Element-steps (points + interactions, times samples) a render may take.
@@ -57,18 +58,19 @@ pub fn calibrate(p: Prepared) -> Prepared {
     p.rest_out = rest_outputs(&mut p);
     let size = (p.engine.info().num_points + p.engine.info().num_interactions).max(1) as f64;
     let budget = (WORK_BUDGET / size).max(1.0);
-    let held = p
-        .exciters
-        .iter()
-        .any(|x| matches!(x.kind, ExciterKind::Bow | ExciterKind::Press));
     let sr = p.sample_rate;
-    let note_frames = (SECONDS * if held { 2.0 } else { 1.0 } * sr).min(budget) as usize;
-    let drum_frames = (DRUM_SECONDS * sr).min(budget) as usize;
+    let note_frames = (SECONDS * sr).min(budget) as usize;
+    // A kick lasts about 0.3 s: its window is not shortened below a quarter second.
+    let drum_frames = (DRUM_SECONDS * sr).min(budget.max(0.25 * sr)) as usize;
     let (p1, note) = peak(p, note_frames, true, None);
     // The drum, when the sidechain pushes a force input.
-    let (mut p3, drum) = if super::force_channels(&p1, super::host::default_order(false)) != 0 {
+    // Played on every channel that feeds the model (a drum on a stereo sidechain moves its
+    // audio-rate parameters too), when some of them push it.
+    let order = super::host::default_order(false);
+    let mask = super::fed_channels(&p1, order);
+    let (mut p3, drum) = if super::pushing_channels(&p1, order) != 0 {
         let kick = kick(drum_frames, sr);
-        peak(p1, drum_frames, false, Some(&kick))
+        peak(p1, drum_frames, false, Some((&kick, mask)))
     } else {
         (p1, 0.0)
     };
@@ -82,8 +84,82 @@ pub fn calibrate(p: Prepared) -> Prepared {
     };
     p3.output_trim = output.clamp(OUTPUT_TRIM_RANGE.0, OUTPUT_TRIM_RANGE.1);
     p3.input_trim = input.clamp(INPUT_TRIM_RANGE.0, INPUT_TRIM_RANGE.1);
+    if note > SILENT && drum > SILENT {
+        p3 = refine_input_trim(p3, note, drum_frames, mask);
+    }
     p3
 }
+
+/// The kick's answer is not proportional to its force where a hammer or a contact stands in
+/// between (a weaker push may press the hammer onto the plate, or not reach the string at
+/// all): the input trim is checked by playing the kick through it, and searched for (a
+/// bisection of its logarithm between a trim found too quiet and one too loud, widened by
+/// [`MAX_STEP`] while one side is missing) until the kick peaks within [`REFINE_DB`] of the
+/// note (aiming [`AIM_DB`] above it), for at most [`REFINE_PASSES`] renders. The trim kept
+/// is the closest one measured that does not sound louder than that aim by more than
+/// [`HOT_DB`], the loudest quieter one otherwise.
+fn refine_input_trim(p: Prepared, note: f64, frames: usize, mask: u16) -> Prepared {
+    let mut p = p;
+    let output = p.output_trim;
+    p.output_trim = 1.0;
+    let kick = kick(frames, p.sample_rate);
+    let (mut lo, mut hi): (Option<f64>, Option<f64>) = (None, None);
+    // (trim, dB off the note) of every render.
+    let mut tried: Vec<(f64, f64)> = Vec::new();
+    let mut t = p.input_trim;
+    for _ in 0..REFINE_PASSES {
+        p.input_trim = t;
+        let (back, drum) = peak(p, frames, false, Some((&kick, mask)));
+        p = back;
+        // Aimed a little above the note: where a hammer stands in between, a kick a little
+        // weaker than the reference still reaches it.
+        let off = if drum > SILENT {
+            20.0 * (drum / note).log10() - AIM_DB
+        } else {
+            -240.0
+        };
+        tried.push((t, off));
+        if off.abs() <= REFINE_DB {
+            break;
+        }
+        if off < 0.0 {
+            lo = Some(lo.map_or(t, |l: f64| l.max(t)));
+        } else {
+            hi = Some(hi.map_or(t, |h: f64| h.min(t)));
+        }
+        t = match (lo, hi) {
+            (Some(l), Some(h)) => (l * h).sqrt(),
+            (Some(l), None) if off > -200.0 => l * 10f64.powf(-off / 20.0).min(MAX_STEP),
+            (Some(l), None) => l * MAX_STEP,
+            (None, Some(h)) => h * 10f64.powf(-off / 20.0).max(1.0 / MAX_STEP),
+            (None, None) => t,
+        }
+        .clamp(INPUT_TRIM_RANGE.0, INPUT_TRIM_RANGE.1);
+    }
+    let keep = tried
+        .iter()
+        .filter(|(_, off)| *off <= HOT_DB && *off > -200.0)
+        .min_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .or_else(|| {
+            tried
+                .iter()
+                .filter(|(_, off)| *off <= 0.0)
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+        })
+        .map_or(p.input_trim, |(t, _)| *t);
+    p.input_trim = keep;
+    p.output_trim = output;
+    p
+}
+
+/// How many renders the input trim's search may take, how close it must land, the largest
+/// step of a correction, and how much louder than the note a kick may be kept.
+const REFINE_PASSES: usize = 6;
+const REFINE_DB: f64 = 2.0;
+const MAX_STEP: f64 = 100.0;
+const HOT_DB: f64 = 4.0;
+/// Where the search aims, dB above the note.
+const AIM_DB: f64 = 2.0;
 
 /// Each output's value after one step from rest with every input at rest.
 fn rest_outputs(p: &mut Prepared) -> Vec<f64> {
@@ -102,9 +178,10 @@ fn rest_outputs(p: &mut Prepared) -> Vec<f64> {
 }
 
 /// Plays the model for `frames` samples from rest, with the measuring note at the first
-/// sample (`note`) and `drum` on the sidechain's first two channels, and returns it at rest
-/// with the peak of its outputs (the main pair and the auxiliary ones) at unit gain.
-fn peak(p: Prepared, frames: usize, note: bool, drum: Option<&[f32]>) -> (Prepared, f64) {
+/// sample (`note`) and `drum` on the host channels of its mask (those that push force
+/// inputs), and returns it at rest with the peak of its outputs (the main pair and the
+/// auxiliary ones) at unit gain.
+fn peak(p: Prepared, frames: usize, note: bool, drum: Option<(&[f32], u16)>) -> (Prepared, f64) {
     let sr = p.sample_rate;
     let controls = Controls {
         output_db: MEASURE_GAIN_DB,
@@ -128,9 +205,12 @@ fn peak(p: Prepared, frames: usize, note: bool, drum: Option<&[f32]>) -> (Prepar
             std::iter::once(Timed::new(0, Event::note_on(MEASURE_KEY, MEASURE_VELOCITY)))
                 .filter(|_| first);
         let mut host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
-        if let Some(d) = drum {
-            host[2] = d.get(done..);
-            host[3] = d.get(done..);
+        if let Some((d, mask)) = drum {
+            for (c, h) in host.iter_mut().enumerate() {
+                if mask & (1 << c) != 0 {
+                    *h = d.get(done..);
+                }
+            }
         }
         let mut out: [&mut [f32]; MAX_HOST_OUTPUTS] = buffers.each_mut().map(|b| &mut b[..len]);
         inst.process(
@@ -150,6 +230,13 @@ fn peak(p: Prepared, frames: usize, note: bool, drum: Option<&[f32]>) -> (Prepar
     }
     let [current, _, _] = inst.take_models();
     let mut p = *current.expect("the instrument keeps the model it plays");
+    // One step with every input at rest puts the audio-rate parameters a key pressed back at
+    // their defaults; the reset then puts the points back.
+    let n_in = p.roles.len();
+    let mut rest = vec![0.0; n_in];
+    rest.copy_from_slice(&p.rest[..n_in]);
+    let mut outputs = vec![0.0; p.num_outputs];
+    p.engine.process(1, &rest, &mut outputs);
     p.engine.reset();
     p.rest_gestures();
     let gain = 10f64.powf(MEASURE_GAIN_DB / 20.0);

@@ -87,12 +87,12 @@ macro_rules! clamp_view {
 mod expression;
 use expression::{tune_voice, SharedGains};
 
-/// The host channels ([`host::channel`] numbering, as bits) that feed the force inputs of
-/// `m`: by the script's `~route`s, else in `order`.
-pub(crate) fn force_channels(m: &Prepared, order: &[RouteSource]) -> u16 {
+/// The host channels ([`host::channel`] numbering, as bits) that push the model: the ones
+/// that feed its force and position inputs, by the script's `~route`s, else in `order`.
+pub(crate) fn pushing_channels(m: &Prepared, order: &[RouteSource]) -> u16 {
     let mut mask = 0u16;
     for (k, role) in m.roles.iter().enumerate() {
-        if *role != InputRole::Force {
+        if !matches!(role, InputRole::Force | InputRole::Position) {
             continue;
         }
         let source = m.routing[k].or_else(|| order.get(k).copied());
@@ -102,6 +102,24 @@ pub(crate) fn force_channels(m: &Prepared, order: &[RouteSource]) -> u16 {
     }
     mask
 }
+
+/// The host channels ([`host::channel`] numbering, as bits) that feed any input of `m`.
+pub(crate) fn fed_channels(m: &Prepared, order: &[RouteSource]) -> u16 {
+    let mut mask = 0u16;
+    for (k, role) in m.roles.iter().enumerate() {
+        if *role == InputRole::Unused {
+            continue;
+        }
+        let source = m.routing[k].or_else(|| order.get(k).copied());
+        if let Some(c) = source.and_then(host::channel) {
+            mask |= 1 << c;
+        }
+    }
+    mask
+}
+
+/// The sidechain's first two channels: a trigger listens there even when they push nothing.
+const SIDECHAIN_PAIR: u16 = 0b1100;
 
 /// The sustain pedal's controller: it holds released voices.
 pub const SUSTAIN_CC: u8 = 64;
@@ -119,8 +137,8 @@ pub struct BlockReport {
     pub loudest: f64,
     /// A model crossfade is still running.
     pub fading: bool,
-    /// The loudest sample of the host channels that push the model's force inputs (or, in
-    /// trigger mode, play it): the editor's input meter.
+    /// The loudest sample of the host channels that push the model's force and position
+    /// inputs (in trigger mode, with the sidechain's first pair): the editor's input meter.
     pub input_peak: f64,
     /// Strikes the sidechain trigger played.
     pub triggered: u32,
@@ -453,11 +471,17 @@ impl Instrument {
         let mut automated = controls != self.controls;
         self.controls = controls;
         let mut report = BlockReport::default();
-        // The host channels that push force inputs: the input meter's, and the trigger's.
-        let mask = self
+        // The host channels that push the model: the input meter's, and with the sidechain's
+        // pair, the trigger's.
+        let pushing = self
             .current
             .as_deref()
-            .map_or(0, |m| force_channels(m, self.order));
+            .map_or(0, |m| pushing_channels(m, self.order));
+        let mask = if self.controls.trigger {
+            pushing | SIDECHAIN_PAIR
+        } else {
+            pushing
+        };
         let host_sample = |c: usize, n: usize| -> f64 {
             let src: Option<&[f32]> = if main_in_place && c < 2 {
                 out.get(c).map(|s| &**s)

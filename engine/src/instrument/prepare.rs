@@ -94,7 +94,8 @@ pub struct Prepared {
     /// legacy projects).
     pub rest_out: Vec<f64>,
     /// The automatic output trim (linear; the Output Gain knob adds to it) and the trim of
-    /// host force signals (the sidechain), found when the model was prepared
+    /// the host signals that push the model (the sidechain on force and position inputs;
+    /// Force and Position Gain add to it), found when the model was prepared
     /// ([`super::level`]); 1 in legacy projects.
     pub output_trim: f64,
     pub input_trim: f64,
@@ -228,6 +229,9 @@ pub fn prepare_with(
             settings.reference_key = concert_key(f);
         }
     }
+    // The stability limits hold for a key held down: the `audioParam`s a key presses (a
+    // bow's friction) are analysed at their pressed values, and put back after.
+    let pressed = press_audio_params(&mut engine, &exciters);
     // The exact limit where it applies; the Gershgorin envelope (whose scale the macro
     // envelopes share) otherwise.
     let gershgorin = envelope(&mut engine);
@@ -250,6 +254,10 @@ pub fn prepare_with(
         })
         .collect();
 
+    for (id, value) in pressed {
+        let _ = engine.set_param(id, value);
+    }
+    engine.apply_pending_changes();
     let macro_units = macro_units(&mut engine, &macros, note_input);
 
     let rate = match spec.sample_rate_mode {
@@ -292,6 +300,41 @@ pub fn prepare_with(
         prepared = super::level::calibrate(prepared);
     }
     Ok(prepared)
+}
+
+/// Sets every `audioParam` that a press exciter drives to its value with the key fully
+/// down (its default + the press's depth, inside the press's limits), and returns the
+/// values to put back.
+fn press_audio_params(engine: &mut Engine, exciters: &[Exciter]) -> Vec<(crate::ParamId, f64)> {
+    let mut old = Vec::new();
+    for x in exciters
+        .iter()
+        .filter(|x| x.kind == ExciterKind::Press && x.role == InputRole::AudioParam)
+    {
+        let names: Vec<String> = engine.info().inputs[x.input]
+            .iter()
+            .filter_map(|u| match u {
+                InputUse::Param(name) => Some(name.to_string()),
+                _ => None,
+            })
+            .collect();
+        for name in names {
+            let Some(id) = engine.param_id(&name) else {
+                continue;
+            };
+            let Some(value) = engine.param(id) else {
+                continue;
+            };
+            if engine
+                .set_param(id, value + x.amount.clamp(x.low, x.high))
+                .is_ok()
+            {
+                old.push((id, value));
+            }
+        }
+    }
+    engine.apply_pending_changes();
+    old
 }
 
 /// The MIDI key (fractional) whose equal-tempered pitch is `f` Hz, A4 = 440 Hz at key 69.
@@ -594,9 +637,10 @@ impl Prepared {
     /// (`host_in`, indexed as [`super::host::channel`] numbers them). Each model input takes
     /// the channel its `~route` names, else the next of `order`; a position input receives
     /// its rest + signal × `position`, a force input signal × `force` ×
-    /// [`Prepared::force_scale`] × [`Prepared::input_trim`] (nothing with `trigger`: the
-    /// sidechain then plays strikes), an audio-rate parameter the raw signal (the engine adds
-    /// its declared default). An unfed input holds its rest. Returns whether a host signal
+    /// [`Prepared::force_scale`] × [`Prepared::input_trim`], a position input its rest +
+    /// signal × `position` × the same trim (neither with `trigger`: the sidechain then plays
+    /// strikes), an audio-rate parameter the raw signal (the engine adds its declared default).
+    /// An unfed input holds its rest. Returns whether a host signal
     /// reached an input.
     pub fn fill_inputs(
         &mut self,
@@ -611,10 +655,10 @@ impl Prepared {
         for (k, role) in self.roles.iter().enumerate() {
             let source = self.routing[k].or_else(|| order.get(k).copied());
             let gain = match role {
-                // In trigger mode the host's force signals become strikes instead.
-                InputRole::Force if trigger => 0.0,
+                // In trigger mode the host's signals that push the model become strikes.
+                InputRole::Force | InputRole::Position if trigger => 0.0,
                 InputRole::Force => force * self.force_scale * self.input_trim,
-                InputRole::Position => position,
+                InputRole::Position => position * self.input_trim,
                 InputRole::AudioParam => 1.0,
                 InputRole::Unused => 0.0,
             };

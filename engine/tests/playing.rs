@@ -1,0 +1,578 @@
+//! Every preset as a musician plays it, through the instrument the plugin runs: a note lands
+//! in the level band and in tune, softer notes are softer, every exciter kind sounds and stops
+//! as docs/LANGUAGE.md §12.4 says, a bowed chord is the sum of its notes, a kick on the
+//! sidechain strikes like a medium note, and trigger mode turns a drum loop into strikes.
+
+mod common;
+
+use common::{cents, peak_frequency};
+use ressort_engine::instrument::dsp::CEILING_KNEE;
+use ressort_engine::instrument::{
+    self, Controls, Event, Gains, Instrument, Prepared, Timed, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS,
+};
+use ressort_engine::{ExciterKind, ScaleClass};
+use std::path::PathBuf;
+
+/// Every preset script of `models/`, by name.
+fn presets() -> Vec<(String, String)> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let mut files: Vec<(String, String)> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "mdl"))
+        .map(|p| {
+            let name = p.file_stem().unwrap().to_string_lossy().into_owned();
+            (name, std::fs::read_to_string(&p).unwrap())
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+fn preset(name: &str) -> String {
+    presets()
+        .into_iter()
+        .find(|p| p.0 == name)
+        .unwrap_or_else(|| panic!("models/{name}.mdl"))
+        .1
+}
+
+/// A preset prepared once at one rate, played from rest as often as a test asks.
+struct Player {
+    model: Option<Box<Prepared>>,
+    sample_rate: f64,
+    /// The model's engine as prepared: at rest, every parameter as declared (a played copy
+    /// holds the values its exciters last pressed).
+    template: ressort_engine::Engine,
+}
+
+/// What one performance gave: every host output channel, and the strikes the sidechain
+/// trigger played.
+struct Take {
+    channels: Vec<Vec<f32>>,
+    triggered: u32,
+    /// The Stiffness and Damping gains the instrument played the last note with.
+    gains: Gains,
+}
+
+impl Take {
+    fn peak(&self) -> f64 {
+        self.channels
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs() as f64))
+    }
+
+    fn peak_db(&self) -> f64 {
+        db(self.peak())
+    }
+
+    /// The peak of the main channels between `from` and `to` seconds.
+    fn peak_between(&self, sr: f64, from: f64, to: f64) -> f64 {
+        let (a, b) = ((from * sr) as usize, (to * sr) as usize);
+        self.channels[..2]
+            .iter()
+            .flat_map(|c| &c[a.min(c.len())..b.min(c.len())])
+            .fold(0.0f64, |m, v| m.max(v.abs() as f64))
+    }
+
+    fn left(&self) -> Vec<f64> {
+        self.channels[0].iter().map(|&v| v as f64).collect()
+    }
+}
+
+fn db(x: f64) -> f64 {
+    if x > 0.0 {
+        20.0 * x.log10()
+    } else {
+        -240.0
+    }
+}
+
+impl Player {
+    fn new(script: &str, sample_rate: f64) -> Player {
+        let mut model = instrument::prepare("test", script, sample_rate).expect("it prepares");
+        if let Some(v) = model.settings.voices {
+            model.set_voices(v as usize);
+        }
+        Player {
+            template: model.engine.clone(),
+            model: Some(Box::new(model)),
+            sample_rate,
+        }
+    }
+
+    fn model(&self) -> &Prepared {
+        self.model.as_deref().unwrap()
+    }
+
+    /// Plays `events` (sample, event) and `sidechain` (both channels) for `seconds` with
+    /// `controls`, from rest.
+    fn play(
+        &mut self,
+        controls: Controls,
+        events: &[(usize, Event)],
+        sidechain: Option<&[f32]>,
+        seconds: f64,
+    ) -> Take {
+        let sr = self.sample_rate;
+        let mut model = self.model.take().expect("a model");
+        model.engine.reset();
+        model.rest_gestures();
+        if let Some(b) = model.bank.as_mut() {
+            b.clear();
+        }
+        let channels = match model.num_outputs {
+            0..=2 => 2,
+            n => n.min(MAX_HOST_OUTPUTS).div_ceil(2) * 2,
+        };
+        let mut inst = Instrument::new(sr, controls);
+        inst.set_model(model);
+        let frames = (seconds * sr) as usize;
+        let mut out = vec![vec![0.0f32; frames]; channels];
+        let block = 480;
+        let mut done = 0;
+        let mut triggered = 0;
+        while done < frames {
+            let len = block.min(frames - done);
+            let mut evs = events
+                .iter()
+                .filter(|(t, _)| *t >= done && *t < done + len)
+                .map(|&(t, e)| Timed::new((t - done) as u32, e));
+            let mut host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+            if let Some(s) = sidechain {
+                host[2] = s.get(done..);
+                host[3] = s.get(done..);
+            }
+            let mut slices: Vec<&mut [f32]> =
+                out.iter_mut().map(|c| &mut c[done..done + len]).collect();
+            let report = inst.process(len, &host, false, &mut evs, &controls, &mut slices);
+            triggered += report.triggered;
+            done += len;
+        }
+        let gains = inst.gains();
+        let [model, _, _] = inst.take_models();
+        self.model = model;
+        Take {
+            channels: out,
+            triggered,
+            gains,
+        }
+    }
+
+    /// One note held for `seconds`.
+    fn note(&mut self, key: u8, velocity: f32, seconds: f64) -> Take {
+        self.play(
+            Controls::DEFAULT,
+            &[(0, Event::note_on(key, velocity))],
+            None,
+            seconds,
+        )
+    }
+}
+
+/// The level band of a C4 note at velocity 0.8, dBFS.
+const BAND: (f64, f64) = (-18.0, -6.0);
+/// The widest spread of those levels over every preset.
+const SPREAD_DB: f64 = 12.0;
+/// How much quieter a note at velocity 0.2 is than one at 0.8, at least.
+const SOFTER_DB: f64 = 3.0;
+
+#[test]
+fn every_preset_lands_in_the_level_band_and_velocity_is_loudness() {
+    const SR: f64 = 48_000.0;
+    let mut wrong = Vec::new();
+    let (mut lowest, mut highest) = (f64::INFINITY, f64::NEG_INFINITY);
+    println!("preset                     v0.8 dBFS  v1.0 dBFS  v0.2 dBFS");
+    for (name, script) in presets() {
+        let mut p = Player::new(&script, SR);
+        let medium = p.note(60, 0.8, 2.0).peak_db();
+        let loud = p.note(60, 1.0, 2.0).peak_db();
+        let soft = p.note(60, 0.2, 2.0).peak_db();
+        println!("{name:<26} {medium:9.1} {loud:10.1} {soft:10.1}");
+        lowest = lowest.min(medium);
+        highest = highest.max(medium);
+        if !(BAND.0..=BAND.1).contains(&medium) {
+            wrong.push(format!("{name}: C4 at 0.8 peaks at {medium:.1} dBFS"));
+        }
+        if loud > db(CEILING_KNEE) {
+            wrong.push(format!(
+                "{name}: C4 at 1.0 reaches the ceiling ({loud:.1} dBFS)"
+            ));
+        }
+        if soft > medium - SOFTER_DB {
+            wrong.push(format!(
+                "{name}: velocity 0.2 ({soft:.1} dBFS) is not softer than 0.8 ({medium:.1})"
+            ));
+        }
+    }
+    println!("spread {:.1} dB", highest - lowest);
+    if highest - lowest > SPREAD_DB {
+        wrong.push(format!("the levels spread over {:.1} dB", highest - lowest));
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// Keys to check a pitched preset at: C3, C4, A4 and its own key where they are in tune (at
+/// most three octaves below its pitch, not above its highest key), then its own key and the
+/// fifth and octave below it.
+fn keys_of(m: &Prepared) -> Vec<u8> {
+    let own = m.settings.reference_key;
+    let top = m.highest_key().unwrap_or(own + 12.0).floor();
+    let mut keys: Vec<u8> = [48.0, 60.0, 69.0, own.round()]
+        .into_iter()
+        .filter(|&k| k <= top && k >= own - 36.0)
+        .map(|k| k as u8)
+        .collect();
+    for k in [
+        own.round().min(top),
+        own.round().min(top) - 7.0,
+        own.round().min(top) - 12.0,
+    ] {
+        if keys.len() < 3 && !keys.contains(&(k as u8)) {
+            keys.push(k as u8);
+        }
+    }
+    keys.sort();
+    keys.dedup();
+    keys.truncate(3);
+    keys
+}
+
+/// The pitch closest to `expected_hz` in the held part of a note (from 0.3 s to its end): the
+/// strongest peak within half a semitone of it, interpolated.
+fn pitch_near(take: &Take, sr: f64, expected_hz: f64) -> f64 {
+    let left = take.left();
+    let part = &left[(0.3 * sr) as usize..];
+    let ratio = 2f64.powf(0.5 / 12.0);
+    peak_frequency(part, sr, expected_hz / ratio, expected_hz * ratio)
+}
+
+/// The reference mode as the instrument tuned it for a note: the mode of the model as
+/// prepared, at the gains it played the note with, closest to `expected_hz`.
+fn tuned_mode(template: &ressort_engine::Engine, gains: &Gains, expected_hz: f64) -> f64 {
+    let mut e = template.clone();
+    e.set_class_gain(ScaleClass::Stiffness, gains.stiffness);
+    e.set_class_gain(ScaleClass::Damping, gains.damping);
+    let a = e.modes(None);
+    a.modes
+        .iter()
+        .map(|m| m.frequency_hz)
+        .min_by(|a, b| {
+            cents(*a, expected_hz)
+                .abs()
+                .total_cmp(&cents(*b, expected_hz).abs())
+        })
+        .unwrap_or(0.0)
+}
+
+/// How far a bow's stick and slip moves a string's pitch from its mode: with the bowing
+/// point near the string's end, the presets' bows sound up to about ten cents off, sharp or
+/// flat with the bow's force (measured; the mode itself is tuned exactly).
+const BOWED_CENTS: f64 = 12.0;
+
+#[test]
+fn pitched_presets_play_in_tune_at_three_keys_and_three_rates() {
+    let mut wrong = Vec::new();
+    let mut checked = 0;
+    for (name, script) in presets() {
+        for sr in [44_100.0, 48_000.0, 96_000.0] {
+            let mut p = Player::new(&script, sr);
+            if p.model().settings.unpitched {
+                break;
+            }
+            let bowed = p
+                .model()
+                .exciters
+                .iter()
+                .any(|x| x.kind == ExciterKind::Bow);
+            let heard_within = if bowed { BOWED_CENTS } else { 5.0 };
+            for key in keys_of(p.model()) {
+                let expected = 440.0 * 2f64.powf((key as f64 - 69.0) / 12.0);
+                let take = p.note(key, 0.8, 1.5);
+                // The reference mode sits on the key; the note sounds there.
+                let mode = cents(tuned_mode(&p.template, &take.gains, expected), expected);
+                let heard = cents(pitch_near(&take, sr, expected), expected);
+                checked += 1;
+                println!(
+                    "{name:<26} {sr:>6} Hz  key {key:>3}  mode {mode:+6.2} cents  heard \
+                     {heard:+6.2} cents"
+                );
+                if mode.abs() > 5.0 || heard.abs() > heard_within {
+                    wrong.push(format!(
+                        "{name} at {sr} Hz, key {key}: mode {mode:+.1} cents, heard \
+                         {heard:+.1} cents"
+                    ));
+                }
+            }
+        }
+    }
+    assert!(checked >= 3 * 3 * 10, "only {checked} notes checked");
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// Controls for a linear output stage: far below the ceiling's knee, no DC filter.
+fn quiet() -> Controls {
+    Controls {
+        output_db: -30.0,
+        dc_filter: false,
+        ..Controls::DEFAULT
+    }
+}
+
+/// The peak of `take`'s main channels in every `step` seconds.
+fn envelope(take: &Take, sr: f64, step: f64) -> Vec<f64> {
+    let n = (step * sr) as usize;
+    let left = &take.channels[0];
+    left.chunks(n)
+        .map(|c| c.iter().fold(0.0f64, |m, v| m.max(v.abs() as f64)))
+        .collect()
+}
+
+#[test]
+fn a_bow_sounds_while_its_key_is_held_and_leaves_at_note_off() {
+    const SR: f64 = 48_000.0;
+    let script = preset("bowed-string");
+    let mut p = Player::new(&script, SR);
+    let off = (1.5 * SR) as usize;
+    let events = [(0, Event::note_on(45, 0.8)), (off, Event::note_off(45))];
+    let take = p.play(Controls::DEFAULT, &events, None, 3.0);
+    let env = envelope(&take, SR, 0.1);
+    println!(
+        "bowed, held 1.5 s: {:?}",
+        env.iter().map(|&v| db(v).round()).collect::<Vec<_>>()
+    );
+    // It speaks, and holds: the last half second of the key is as loud as the note gets.
+    let held = take.peak_between(SR, 1.0, 1.5);
+    assert!(db(held) > -20.0, "the bow sustains ({:.1} dBFS)", db(held));
+    assert!(held > 0.5 * take.peak(), "the bow keeps the string going");
+    // At note-off the bow stops: nothing drives the string any more, which only dies away.
+    for w in env[16..].windows(2) {
+        assert!(w[1] <= w[0] * 1.02, "driven after note-off: {env:?}");
+    }
+    // And it leaves: the string rings on as a free string does. A bow that stopped on the
+    // string (its friction not lifted) would damp it: compare with the same bow whose
+    // friction stays at the pressed value.
+    let resting = script
+        .replace("@nlZ audioParam @in5", "@nlZ param 0.2")
+        .replace("~exciter in5 press 0.25\n", "");
+    let mut r = Player::new(&resting, SR);
+    let stays = r.play(Controls::DEFAULT, &events, None, 3.0);
+    let ring = |t: &Take| db(t.peak_between(SR, 2.5, 3.0)) - db(t.peak_between(SR, 1.4, 1.5));
+    println!(
+        "one second after note-off: bow left {:.1} dB, bow resting {:.1} dB",
+        ring(&take),
+        ring(&stays)
+    );
+    assert!(
+        ring(&take) > ring(&stays) + 10.0,
+        "the lifted bow lets the string ring"
+    );
+    // Release damps a released string.
+    let damped = p.play(
+        Controls {
+            release: 1.0,
+            ..Controls::DEFAULT
+        },
+        &events,
+        None,
+        3.0,
+    );
+    assert!(
+        ring(&damped) < ring(&take) - 3.0,
+        "Release damps the released string"
+    );
+    // Held all along, the same note keeps sounding.
+    let sustained = p.play(Controls::DEFAULT, &events[..1], None, 3.0);
+    assert!(sustained.peak_between(SR, 2.5, 3.0) > 0.5 * held);
+}
+
+#[test]
+fn a_pluck_plucks_once_per_key() {
+    const SR: f64 = 48_000.0;
+    let mut p = Player::new(&preset("plucked-harmonics"), SR);
+    let take = p.play(quiet(), &[(0, Event::note_on(44, 0.8))], None, 1.5);
+    let env = envelope(&take, SR, 0.02);
+    let loudest = env.iter().cloned().fold(0.0, f64::max);
+    let at = env.iter().position(|&v| v == loudest).unwrap();
+    // It sounds at once (within the first 40 ms: the sweep crosses the string in 3 ms) …
+    assert!(at <= 2 && loudest > 0.0, "peak in frame {at}");
+    // … then only dies away: no second pluck while the key is held.
+    for w in env[at..].windows(10) {
+        assert!(w[9] <= w[0] * 1.05, "a second attack: {w:?}");
+    }
+    // Two keys, two plucks (each voice from the first side).
+    let two = p.play(
+        quiet(),
+        &[
+            (0, Event::note_on(44, 0.8)),
+            ((0.5 * SR) as usize, Event::note_on(48, 0.8)),
+        ],
+        None,
+        1.0,
+    );
+    let before = two.peak_between(SR, 0.4, 0.5);
+    let after = two.peak_between(SR, 0.5, 0.55);
+    assert!(
+        after > 1.5 * before,
+        "the second key plucks ({before:e} -> {after:e})"
+    );
+}
+
+/// An oscillator that a finger presses through a stiff spring: a press moves its rest.
+const PRESSED: &str = "\
+@o osc 1. 0.01 0.002 0. 0.
+@in1 posInput 0.
+@f spring @in1 @o 0.01
+@out1 posOutput @o
+~exciter in1 press 0.5 10
+";
+
+#[test]
+fn a_press_holds_its_depth_while_the_key_is_down_and_lets_go() {
+    const SR: f64 = 48_000.0;
+    let mut p = Player::new(PRESSED, SR);
+    let off = (1.0 * SR) as usize;
+    let take = p.play(
+        quiet(),
+        &[(0, Event::note_on(60, 1.0)), (off, Event::note_off(60))],
+        None,
+        2.0,
+    );
+    let left = take.left();
+    let gain = 10f64.powf(-30.0 / 20.0) * p.model().output_trim;
+    // Pressed by 0.5 through an equal spring, the oscillator settles halfway, at 0.25.
+    let held = left[off - 1] / gain;
+    assert!((held - 0.25).abs() < 0.01, "held at {held}");
+    let released = left[left.len() - 1] / gain;
+    assert!(released.abs() < 0.01, "let go: {released}");
+    // Softer keys press less deep.
+    let soft = p.play(quiet(), &[(0, Event::note_on(60, 0.5))], None, 1.0);
+    let half = soft.left()[(SR as usize) - 1] / gain;
+    assert!((half - 0.125).abs() < 0.01, "half velocity: {half}");
+}
+
+#[test]
+fn a_chord_of_three_bowed_notes_is_the_sum_of_the_notes() {
+    const SR: f64 = 48_000.0;
+    let mut p = Player::new(&preset("bowed-string"), SR);
+    let keys = [40u8, 43, 47];
+    let chord: Vec<(usize, Event)> = keys.iter().map(|&k| (0, Event::note_on(k, 0.8))).collect();
+    let together = p.play(quiet(), &chord, None, 1.5).left();
+    let mut sum = vec![0.0f64; together.len()];
+    for &k in &keys {
+        let alone = p
+            .play(quiet(), &[(0, Event::note_on(k, 0.8))], None, 1.5)
+            .left();
+        for (s, a) in sum.iter_mut().zip(alone) {
+            *s += a;
+        }
+    }
+    let peak = together.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let worst = together
+        .iter()
+        .zip(&sum)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    println!("chord peak {peak:e}, largest difference from the sum {worst:e}");
+    assert!(peak > 1e-3, "the chord sounds");
+    assert!(worst <= 1e-5 * peak, "{worst:e} of {peak:e}");
+}
+
+/// The kick of issue 36: a sine gliding 120 → 50 Hz under a 60 ms decay, twice a second,
+/// peaking at −6 dBFS.
+fn kick_loop(seconds: f64, sr: f64, hits: &[f64]) -> Vec<f32> {
+    let frames = (seconds * sr) as usize;
+    let mut x = vec![0.0f64; frames];
+    for &start in hits {
+        let mut phase = 0.0f64;
+        for n in 0..(0.4 * sr) as usize {
+            let t = n as f64 / sr;
+            let f = 50.0 + 70.0 * (-t / 0.03).exp();
+            phase += std::f64::consts::TAU * f / sr;
+            if let Some(s) = x.get_mut((start * sr) as usize + n) {
+                *s += (-t / 0.06).exp() * phase.sin();
+            }
+        }
+    }
+    let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let scale = 10f64.powf(-6.0 / 20.0) / peak;
+    x.iter().map(|v| (v * scale) as f32).collect()
+}
+
+#[test]
+fn a_kick_on_the_sidechain_strikes_like_a_medium_note() {
+    const SR: f64 = 48_000.0;
+    let mut p = Player::new(&preset("mesh-15x15"), SR);
+    let note = p.note(60, 0.8, 2.0).peak_db();
+    let hits: Vec<f64> = (0..8).map(|i| 0.5 * i as f64).collect();
+    let kick = kick_loop(4.0, SR, &hits);
+    let take = p.play(Controls::DEFAULT, &[], Some(&kick), 4.0);
+    let struck = take.peak_db();
+    println!("mesh-15x15: note {note:.1} dBFS, kick {struck:.1} dBFS");
+    assert!(
+        (struck - note).abs() <= 6.0,
+        "kick {struck:.1} vs note {note:.1} dBFS"
+    );
+    assert!(
+        struck < db(CEILING_KNEE),
+        "the kick reaches the ceiling: {struck:.1} dBFS"
+    );
+    // The same kick through every preset: where the sidechain pushes the model it strikes,
+    // and nowhere does it reach the ceiling.
+    let mut hot = Vec::new();
+    for (name, script) in presets() {
+        let mut p = Player::new(&script, SR);
+        let note = p.note(60, 0.8, 2.0).peak_db();
+        let struck = p
+            .play(Controls::DEFAULT, &[], Some(&kick[..96_000]), 2.0)
+            .peak_db();
+        println!("{name:<26} note {note:6.1} dBFS, kick {struck:6.1} dBFS");
+        if struck >= db(CEILING_KNEE) {
+            hot.push(format!("{name}: {struck:.1} dBFS"));
+        }
+    }
+    assert!(hot.is_empty(), "a kick reaches the ceiling: {hot:?}");
+}
+
+#[test]
+fn trigger_mode_turns_a_four_hit_drum_loop_into_four_strikes() {
+    const SR: f64 = 48_000.0;
+    let hits = [0.25, 0.75, 1.25, 1.75];
+    let kick = kick_loop(2.2, SR, &hits);
+    let trigger = Controls {
+        trigger: true,
+        ..Controls::DEFAULT
+    };
+    // A model without voices: each hit strikes it where the drum hits.
+    let mut p = Player::new(&preset("mesh-15x15"), SR);
+    let take = p.play(trigger, &[], Some(&kick), 2.2);
+    assert_eq!(take.triggered, 4, "four hits, four strikes");
+    let note = p.note(60, 0.8, 0.5).peak();
+    for &t in &hits {
+        let before = take.peak_between(SR, t - 0.1, t);
+        let hit = take.peak_between(SR, t, t + 0.1);
+        println!(
+            "hit at {t} s: {:.1} dBFS (before {:.1})",
+            db(hit),
+            db(before)
+        );
+        assert!(hit > before, "a strike at {t} s");
+        // A −6 dBFS hit plays velocity 0.8: a medium note, within 3 dB.
+        assert!(
+            (db(hit) - db(note)).abs() < 3.0,
+            "{:.1} vs {:.1}",
+            db(hit),
+            db(note)
+        );
+    }
+    // Without trigger mode the same loop pushes the model as a force: no strikes.
+    let raw = p.play(Controls::DEFAULT, &[], Some(&kick), 2.2);
+    assert_eq!(raw.triggered, 0);
+    assert_ne!(raw.channels, take.channels);
+    // With voices: each hit plays a voice of its own.
+    let mut v = Player::new(&preset("struck-string"), SR);
+    let take = v.play(trigger, &[], Some(&kick), 2.2);
+    assert_eq!(take.triggered, 4);
+    assert!(take.peak() > 1e-3);
+}
