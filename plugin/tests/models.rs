@@ -48,6 +48,9 @@ fn the_stiffness_limit_matches_the_stability_analysis() {
         let mut p = prepare(preset.id, preset.text, 48_000.0).unwrap();
         let limit = p.envelope.max_stiffness(1.0);
         assert!(limit.is_finite() && limit > 0.0, "{}: {limit}", preset.id);
+        // The limits hold for a key held down: a bow's friction at its pressed value.
+        let exciters = p.exciters.clone();
+        ressort_engine::instrument::prepare::press_audio_params(&mut p.engine, &exciters);
         let gershgorin = ressort_engine::instrument::envelope::envelope(&mut p.engine);
         let bound = gershgorin.max_stiffness(1.0);
         let exact = p.engine.exact_stability();
@@ -261,50 +264,62 @@ fn host_directives_configure_the_plugin() {
 }
 
 /// Every preset, played in the instrument layout as its header says, moves its first output
-/// clearly: a full-velocity MIDI note on the note input, or, for presets without one, a steady
-/// sidechain ramp down at 3e-5 units per sample (the bow speed the headers give; in a second
-/// it also sweeps a plectrum through its string) on `@in1` and `@in2`. The inputs the instrument layout does
-/// not feed (`@in3` on) stay silent, so an audio-rate parameter there holds its default.
+/// clearly: a full-velocity MIDI note held down (its strike and its exciters: bows, plucks,
+/// presses), or, for a preset a key does not play, a steady sidechain ramp down at 3e-5 units
+/// per sample (the bow speed the headers give) on `@in1` and `@in2`. The inputs the
+/// instrument layout does not feed (`@in3` on) stay silent, so an audio-rate parameter there
+/// holds its default.
 #[test]
 fn every_preset_moves_its_first_output_when_played() {
+    use ressort_engine::instrument::{Controls, Event, Instrument, Timed, MAX_HOST_INPUTS};
     const SR: f64 = 48_000.0;
     const FRAMES: usize = 48_000;
-    let order = ressort_plugin::host::default_order(false);
+    const BLOCK: usize = 256;
     let mut silent = Vec::new();
     for preset in PRESETS {
-        let mut p = prepare(preset.id, preset.text, SR).unwrap();
-        let n_in = p.roles.len();
-        let n_out = p.outputs.len() / CHUNK;
-        let strike = p.note_input.map(|_| p.settings.note_force * p.strike_scale);
-        let mut host_in = [[0.0; CHUNK]; 4];
-        let (mut rest, mut peak) = (None, 0.0f64);
-        for block in 0..FRAMES / CHUNK {
-            if strike.is_none() {
-                for (i, s) in host_in[2].iter_mut().enumerate() {
-                    *s = -3e-5 * (block * CHUNK + i) as f64;
+        let p = prepare(preset.id, preset.text, SR).unwrap();
+        let played = p.note_input.is_some() || !p.exciters.is_empty();
+        // The output stage's own gain, so that the peak reads in the model's units.
+        let trim = p.output_trim;
+        let controls = Controls {
+            dc_filter: false,
+            output_db: -60.0,
+            ..Controls::DEFAULT
+        };
+        let mut inst = Instrument::new(SR, controls);
+        inst.set_model(Box::new(p));
+        let (mut l, mut r) = ([0.0f32; BLOCK], [0.0f32; BLOCK]);
+        let mut ramp = vec![0.0f32; BLOCK];
+        let mut peak = 0.0f64;
+        for block in 0..FRAMES / BLOCK {
+            let note = (block == 0 && played).then(|| Timed::new(0, Event::note_on(60, 1.0)));
+            let mut host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
+            if !played {
+                for (i, s) in ramp.iter_mut().enumerate() {
+                    *s = (-3e-5 * (block * BLOCK + i) as f64) as f32;
                 }
-                host_in[3] = host_in[2];
+                host[2] = Some(&ramp);
+                host[3] = Some(&ramp);
             }
-            p.fill_inputs(&host_in, order, CHUNK, 1.0, 1.0, false);
-            if let (Some(k), Some(strike), 0) = (p.note_input, strike, block) {
-                p.inputs[k * CHUNK] += strike;
-            }
-            let report = p.engine.process(
-                CHUNK,
-                &p.inputs[..n_in * CHUNK],
-                &mut p.outputs[..n_out * CHUNK],
+            let mut out: [&mut [f32]; 2] = [&mut l, &mut r];
+            let report = inst.process(
+                BLOCK,
+                &host,
+                false,
+                &mut note.into_iter(),
+                &controls,
+                &mut out,
             );
-            assert!(!report.tripped, "{} exploded", preset.id);
-            let rest = *rest.get_or_insert(p.outputs[0]);
-            peak = p.outputs[..CHUNK]
-                .iter()
-                .fold(peak, |m, v| m.max((v - rest).abs()));
+            assert_eq!(report.trips, 0, "{} exploded", preset.id);
+            peak = l.iter().fold(peak, |m, v| m.max(v.abs() as f64));
         }
-        // As in the engine's preset test: 1e-4 of the strike for struck presets (NoFx Drone,
-        // the quietest, is about 5 times above), 1e-6 for the quiet bowed ones.
-        let bar = strike.map_or(1e-6, |s| 1e-4 * s.abs());
+        // In the model's units: the output gain and the trim taken back off.
+        let peak = peak / (1e-3 * trim);
+        // A hundredth of the level every preset is trimmed to would be a faint sound; these
+        // move by far more.
+        let bar = 1e-6;
         println!(
-            "{:<24} out1 peak excursion {peak:.3e} (bar {bar:.1e}, strike {strike:?})",
+            "{:<24} out1 peak excursion {peak:.3e} (played by a key: {played})",
             preset.id
         );
         if !(peak > bar) {
@@ -396,14 +411,8 @@ fn chladni_listening_point_is_a_macro_knob() {
 #[test]
 fn ab_compare_switches_between_two_scripts() {
     let store = ModelStore::default();
-    let a = ModelState {
-        name: "a".into(),
-        script: "@o osc 1. 0.1 0.001 0. 0.\n@out1 posOutput @o\n".into(),
-    };
-    let b = ModelState {
-        name: "b".into(),
-        script: "@o osc 1. 0.2 0.001 0. 0.\n@out1 posOutput @o\n".into(),
-    };
+    let a = ModelState::new("a", "@o osc 1. 0.1 0.001 0. 0.\n@out1 posOutput @o\n");
+    let b = ModelState::new("b", "@o osc 1. 0.2 0.001 0. 0.\n@out1 posOutput @o\n");
     store.activate(48_000.0).expect("the default preset runs");
     store.submit(a.clone()).unwrap();
     assert_eq!(store.compare().active, 0);
@@ -420,10 +429,7 @@ fn ab_compare_switches_between_two_scripts() {
     store.switch_compare().unwrap();
     assert_eq!(store.running(), b);
     // A script with errors changes neither the running model nor the slots.
-    let broken = ModelState {
-        name: "broken".into(),
-        script: "@o osc 1. 0.1\n".into(),
-    };
+    let broken = ModelState::new("broken", "@o osc 1. 0.1\n");
     assert!(store.submit(broken).is_err());
     assert_eq!(store.compare().slots, [Some(a.clone()), Some(b.clone())]);
     // Copying the running script over the other slot.

@@ -230,8 +230,11 @@ fn peak(p: Prepared, frames: usize, note: bool, drum: Option<(&[f32], u16)>) -> 
     }
     let [current, _, _] = inst.take_models();
     let mut p = *current.expect("the instrument keeps the model it plays");
-    // One step with every input at rest puts the audio-rate parameters a key pressed back at
-    // their defaults; the reset then puts the points back.
+    // The gains the note was tuned with go; one step with every input at rest puts the
+    // audio-rate parameters a key pressed back at their defaults; the reset then puts the
+    // points back.
+    p.engine.set_class_gain(crate::ScaleClass::Stiffness, 1.0);
+    p.engine.set_class_gain(crate::ScaleClass::Damping, 1.0);
     let n_in = p.roles.len();
     let mut rest = vec![0.0; n_in];
     rest.copy_from_slice(&p.rest[..n_in]);

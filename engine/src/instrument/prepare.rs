@@ -305,7 +305,7 @@ pub fn prepare_with(
 /// Sets every `audioParam` that a press exciter drives to its value with the key fully
 /// down (its default + the press's depth, inside the press's limits), and returns the
 /// values to put back.
-fn press_audio_params(engine: &mut Engine, exciters: &[Exciter]) -> Vec<(crate::ParamId, f64)> {
+pub fn press_audio_params(engine: &mut Engine, exciters: &[Exciter]) -> Vec<(crate::ParamId, f64)> {
     let mut old = Vec::new();
     for x in exciters
         .iter()
