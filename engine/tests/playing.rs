@@ -576,3 +576,91 @@ fn trigger_mode_turns_a_four_hit_drum_loop_into_four_strikes() {
     assert_eq!(take.triggered, 4);
     assert!(take.peak() > 1e-3);
 }
+
+/// The exciter examples of docs/LANGUAGE.md §12.4: each plays from a held key.
+#[test]
+fn the_guides_exciter_examples_play() {
+    const SR: f64 = 48_000.0;
+    let guide = include_str!("../../docs/LANGUAGE.md");
+    let start = guide.find("### 12.4").expect("§12.4");
+    let end = start + guide[start..].find("\n## ").expect("the next chapter");
+    let section = &guide[start..end];
+    let examples: Vec<&str> = section
+        .split("```mims\n")
+        .skip(1)
+        .map(|b| &b[..b.find("```").unwrap()])
+        .collect();
+    assert_eq!(
+        examples.len(),
+        3,
+        "a bow, a pluck and a strike with a press"
+    );
+    for script in examples {
+        let mut p = Player::new(script, SR);
+        let kinds: Vec<&str> = p.model().exciters.iter().map(|x| x.kind.name()).collect();
+        let take = p.play(
+            Controls::DEFAULT,
+            &[
+                (0, Event::note_on(60, 0.8)),
+                ((0.8 * SR) as usize, Event::note_off(60)),
+            ],
+            None,
+            1.5,
+        );
+        println!("{kinds:?}: {:.1} dBFS", take.peak_db());
+        assert!(
+            (BAND.0..=BAND.1).contains(&take.peak_db()),
+            "{kinds:?}: {:.1}",
+            take.peak_db()
+        );
+    }
+}
+
+#[test]
+fn an_exciter_an_input_cannot_take_is_an_error_at_its_directive() {
+    let bad = [
+        (
+            "@o osc 1. 0.1 0.001 0. 0.\n@in1 frcInput @o\n@out1 posOutput @o\n~exciter in1 bow 1\n",
+            "4:10: error: `~exciter in1 bow`: in1 is not a position input (posInput); a bow \
+             moves an avatar",
+        ),
+        (
+            "@o osc 1. 0.1 0.001 0. 0.\n@in1 posInput 0.\n@s spring @in1 @o 0.1\n\
+             @out1 posOutput @o\n~exciter in1 pluck\n",
+            "5:10: error: `~exciter in1 pluck`: in1 plucks nothing (no nlPluck on @in1): give \
+             the plectrum's travel",
+        ),
+        (
+            "@o osc 1. 0.1 0.001 0. 0.\n@in1 posInput 0.\n@s spring @in1 @o 0.1\n\
+             @out1 posOutput @o\n~exciter in3 press 0.1\n",
+            "5:10: error: `~exciter in3 press`: the model has no input in3",
+        ),
+    ];
+    for (script, expected) in bad {
+        let err = instrument::prepare("bad", script, 48_000.0).unwrap_err();
+        assert_eq!(err.0, vec![expected.to_string()]);
+    }
+    // The parser catches the rest where it reads them.
+    for (script, expected) in [
+        (
+            "~exciter in1 scrape\n",
+            "1:14: error: unknown exciter `scrape`",
+        ),
+        (
+            "~exciter in1 bow -2\n",
+            "1:18: error: `~exciter in1 bow`: bad value `-2`",
+        ),
+        (
+            "~exciter in1 bow\n~exciter in1 press 1\n",
+            "2:1: error: a second `~exciter` for in1",
+        ),
+        (
+            "~note in1\n~exciter in2 strike\n",
+            "2:1: error: a second strike",
+        ),
+    ] {
+        let parsed = ressort_engine::parse(script);
+        let first = parsed.errors().next().expect("an error").to_string();
+        assert!(first.starts_with(expected), "{script:?}: {first}");
+    }
+}

@@ -1633,6 +1633,25 @@ pub mod state {
         blob_from(&v)
     }
 
+    /// A copy of a state blob with another model, played by today's conventions (concert
+    /// pitch, automatic levels): a state [`with_model`] writes has no `playing` field, as
+    /// projects saved before them, and plays as they did.
+    pub fn with_musical_model(blob: &[u8], name: &str, script: &str) -> Vec<u8> {
+        let mut v = json(blob).expect("a valid state blob");
+        let model =
+            serde_json::json!({ "name": name, "script": script, "playing": "musical" }).to_string();
+        v["fields"]["model"] = Value::String(model);
+        blob_from(&v)
+    }
+
+    /// The `playing` field of the model saved in a state blob (None: a legacy project's).
+    pub fn playing(blob: &[u8]) -> Option<String> {
+        let v = json(blob)?;
+        let field = v.get("fields")?.get("model")?.as_str()?;
+        let m: Value = serde_json::from_str(field).ok()?;
+        Some(m.get("playing")?.as_str()?.to_string())
+    }
+
     /// A copy of a state blob with a persistent field set to `json` (its JSON text).
     pub fn with_field(blob: &[u8], name: &str, json: &str) -> Vec<u8> {
         let mut v = self::json(blob).expect("a valid state blob");
