@@ -1841,15 +1841,58 @@ pub fn oscillator_frequency(m: f64, k: f64, k_gain: f64, sample_rate: f64) -> f6
     sample_rate / std::f64::consts::PI * s2.sqrt().asin()
 }
 
+/// The default preset (Mesh 15×15) as a project saved before concert pitch and the automatic
+/// levels: Output Gain +24 dB and the sidechain as raw force, so a one-sample impulse of
+/// −0.05 on `@in1` throws its hammer (the automatic sidechain trim of a new project scales a
+/// drum to strike like a note; a single sample carries too little of a drum's push). For the
+/// tests of the plugin's mechanics (block sizes, sample rates, bad input, sleeping) that
+/// strike it with impulses.
+pub fn struck_default() -> TestPlugin {
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/mesh-15x15.mdl"),
+    )
+    .expect("models/mesh-15x15.mdl");
+    plugin_with_model(
+        "mesh-15x15",
+        &text,
+        &[("output_gain", serde_json::json!({ "f32": 24.0 }))],
+    )
+}
+
 /// A new instance running `script` (loaded through the plugin state while inactive), with
 /// plain parameter values set in the same state (`(string id, JSON value)`).
+/// The state has no `playing` field: the model plays as in a project saved before concert
+/// pitch and the automatic levels (relative tuning, raw sidechain, no trim).
 pub fn plugin_with_model(
     name: &str,
     script: &str,
     params: &[(&str, serde_json::Value)],
 ) -> TestPlugin {
+    plugin_with(name, script, params, false)
+}
+
+/// [`plugin_with_model`] for a model chosen today: concert pitch and the automatic levels (the
+/// state says `"playing": "musical"`).
+pub fn plugin_with_musical_model(
+    name: &str,
+    script: &str,
+    params: &[(&str, serde_json::Value)],
+) -> TestPlugin {
+    plugin_with(name, script, params, true)
+}
+
+fn plugin_with(
+    name: &str,
+    script: &str,
+    params: &[(&str, serde_json::Value)],
+    musical: bool,
+) -> TestPlugin {
     let mut plugin = TestPlugin::new();
-    let mut blob = state::with_model(&plugin.save_state(), name, script);
+    let mut blob = if musical {
+        state::with_musical_model(&plugin.save_state(), name, script)
+    } else {
+        state::with_model(&plugin.save_state(), name, script)
+    };
     for (id, value) in params {
         blob = state::with_param(&blob, id, value.clone());
     }

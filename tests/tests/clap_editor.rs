@@ -9,7 +9,7 @@
 //! goes away).
 
 use ressort_tests::screen::{capture, plot_stats, shows_motion, HostWindow, Xvfb};
-use ressort_tests::{state, thread_count, Score, TestPlugin};
+use ressort_tests::{state, struck_default, thread_count, Score, TestPlugin};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -39,7 +39,7 @@ fn the_editor_opens_in_a_clap_host_and_shows_sidechain_strikes() {
     };
     let host = HostWindow::open(&display, "Test DAW", 1100, 700).expect("host window");
 
-    let mut plugin = TestPlugin::new();
+    let mut plugin = struck_default();
     let threads_before = thread_count();
     let (w, h) = plugin.open_editor(host.window).expect("the editor opens");
     println!("editor size {w}×{h}");

@@ -9,7 +9,7 @@
 use ressort_tests::state;
 use ressort_tests::{
     band_energy_share, cents, oscillator_frequency, peak_frequency, plugin_with_model,
-    run_isolated, Block, ClapId, ProcessStatus, Score, Stereo, TestPlugin,
+    run_isolated, struck_default, Block, ClapId, ProcessStatus, Score, Stereo, TestPlugin,
 };
 use serde_json::json;
 
@@ -185,6 +185,9 @@ fn plugin_describes_its_ports_and_parameters() {
         "Guard Tripped",
         "Bend Range",
         "Velocity Curve",
+        "A4",
+        "Sidechain Trigger",
+        "Trigger Sensitivity",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -223,7 +226,13 @@ fn plugin_describes_its_ports_and_parameters() {
     assert_eq!(tune.as_deref(), Some("+12.00 st"));
     let gain = plugin.param("Output Gain");
     let default_text = plugin.param_text(gain.id, gain.default);
-    assert_eq!(default_text.as_deref(), Some("24.0 dB"));
+    // The automatic level trim sets a new model's level; Output Gain adds to it.
+    assert_eq!(default_text.as_deref(), Some("0.0 dB"));
+    let a4 = plugin.param("A4");
+    assert_eq!(
+        plugin.param_text(a4.id, a4.default).as_deref(),
+        Some("440.0 Hz")
+    );
     assert_eq!(plugin.param_value(p.stiffness.id), Some(0.5));
 
     let inputs = plugin.audio_ports(true);
@@ -259,7 +268,7 @@ fn plugin_describes_its_ports_and_parameters() {
 
 #[test]
 fn renders_at_every_sample_rate_and_block_size() {
-    let mut plugin = TestPlugin::new();
+    let mut plugin = struck_default();
     for sr in [44_100.0, 48_000.0, 96_000.0] {
         let mut reference: Option<(usize, Stereo)> = None;
         for block in [1usize, 64, 333, 4096] {
@@ -297,7 +306,7 @@ fn renders_at_every_sample_rate_and_block_size() {
 #[test]
 fn sidechain_strikes_sound_and_silence_stays_silent() {
     let sr = 48_000.0;
-    let mut plugin = TestPlugin::new();
+    let mut plugin = struck_default();
     plugin.activate(sr, 1, 512);
 
     // At rest, silence in gives exact silence out.
@@ -342,7 +351,7 @@ fn sidechain_strikes_sound_and_silence_stays_silent() {
 #[test]
 fn effect_layout_routes_the_main_input_to_in1() {
     let sr = 48_000.0;
-    let mut plugin = TestPlugin::new();
+    let mut plugin = struck_default();
     plugin
         .select_audio_config("Effect with sidechain")
         .expect("select the effect layout");
@@ -395,7 +404,7 @@ fn non_finite_sidechain_input_gives_finite_output() {
         }
     }
 
-    let mut plugin = TestPlugin::new();
+    let mut plugin = struck_default();
     plugin.activate(sr, 1, 333);
     let out = plugin.render(0.5, 333, &Score::new().with_sidechain(dirty));
     assert_finite_and_sounding(&out.audio, "NaN/Inf in the sidechain");
@@ -427,7 +436,7 @@ fn extreme_parameter_values_stay_finite_and_bounded() {
     ] {
         let mut plugin = match script {
             Some(s) => plugin_with_model(model, s, &[]),
-            None => TestPlugin::new(),
+            None => struck_default(),
         };
         let p = Params::of(&mut plugin);
         let cases: [(&str, Vec<(Param, f64)>); 7] = [
@@ -1070,7 +1079,7 @@ fn corrupted_states_are_rejected_and_the_model_keeps_playing() {
 fn process_status_lets_the_host_sleep_only_when_quiet() {
     let sr = 48_000.0;
     let block = 512usize;
-    let mut plugin = TestPlugin::new();
+    let mut plugin = struck_default();
     plugin.activate(sr, 1, block as u32);
 
     // Long silence: the plugin may be put to sleep.
@@ -1171,8 +1180,8 @@ fn left_difference(a: &Stereo, b: &Stereo) -> f32 {
 /// instrument layout as its header says, moves out1 (the left channel) through the whole
 /// plugin: the rule and the bars of `every_preset_moves_its_first_output_when_played`
 /// (plugin/tests/models.rs), which checks the same on the engine the plugin prepares. A
-/// full-velocity note for presets with a force input, else a sidechain ramp down at 3e-5 per
-/// sample on both channels (a bow or plectrum moving). The bar is the engine test's 1e-6
+/// full-velocity note held down for presets with a force input or exciters (a key bows or
+/// plucks them), else a sidechain ramp down at 3e-5 per sample on both channels. The bar is the engine test's 1e-6
 /// raised by the default +24 dB output gain and rounded down: 1e-5.
 #[test]
 fn every_preset_compiles_and_moves_out1_when_played() {
@@ -1185,10 +1194,15 @@ fn every_preset_compiles_and_moves_out1_when_played() {
     assert!(presets.len() >= 4, "presets: {presets:?}");
     let mut still = Vec::new();
     for (name, script) in &presets {
-        let mut plugin = plugin_with_model(name, script, &[]);
-        let struck = script
-            .lines()
-            .any(|l| !l.trim_start().starts_with('#') && l.contains("frcInput"));
+        // As a project saved before the automatic levels (Output Gain +24 dB): the bar is in
+        // the model's units.
+        let mut plugin =
+            plugin_with_model(name, script, &[("output_gain", json!({ "f32": 24.0 }))]);
+        // A key plays a preset with a force input or exciters (a bow, a pluck): held down.
+        let struck = script.lines().any(|l| {
+            !l.trim_start().starts_with('#')
+                && (l.contains("frcInput") || l.trim_start().starts_with("~exciter"))
+        });
         let score = if struck {
             Score::new().note_on(0, 60, 1.0)
         } else {
@@ -1284,7 +1298,7 @@ fn destroying_instances_after_a_guard_trip_does_not_abort() {
         return;
     }
     let sr = 48_000.0;
-    let mut b = TestPlugin::new();
+    let mut b = struck_default();
     b.activate(sr, 1, 256);
     let before = b.render(0.2, 256, &strikes(&[0], STRIKE));
     assert_finite_and_sounding(&before.audio, "instance B");
@@ -1376,7 +1390,7 @@ fn combined_controls_keep_the_model_stable() {
     ];
     let mut exploded = Vec::new();
     for (what, values, note) in cases {
-        let mut plugin = TestPlugin::new();
+        let mut plugin = struck_default();
         plugin.flush_params(&values);
         plugin.activate(sr, 1, 512);
         let mut score = strikes(&[0], STRIKE);

@@ -3,7 +3,7 @@
 //! test checks its WAV against the instrument). And a note retunes at its own sample.
 
 use ressort_engine::instrument::{self, Controls, Event, Instrument, Timed, MAX_HOST_INPUTS};
-use ressort_tests::{plugin_with_model, Score, Stereo};
+use ressort_tests::{plugin_with_model, plugin_with_musical_model, Score, Stereo};
 use serde_json::json;
 
 const SMALL_MESH: &str = include_str!("../models/small-mesh.mdl");
@@ -65,7 +65,7 @@ fn the_plugin_plays_what_the_instrument_plays() {
         ("output_gain", json!({ "f32": -6.0 })),
         ("macro_1", json!({ "f32": 0.7 })),
     ];
-    let mut plugin = plugin_with_model("small-mesh", SMALL_MESH, &params);
+    let mut plugin = plugin_with_musical_model("small-mesh", SMALL_MESH, &params);
     let frames = 24_000;
     let mut sidechain = Stereo::silence(frames);
     sidechain.left[5_001] = -0.05;

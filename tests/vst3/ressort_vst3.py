@@ -83,6 +83,20 @@ def oscillator_frequency(m: float, k: float, sample_rate: float) -> float:
     return sample_rate / np.pi * np.arcsin(np.sqrt(k_step / (4.0 * m)))
 
 
+def kicks(channels: int, frames: int, every: int, sample_rate: float, peak_db: float = -6.0) -> np.ndarray:
+    """A kick drum every `every` samples on every channel, from sample 0: a sine gliding 120 →
+    50 Hz under a 60 ms decay, each hit peaking at `peak_db` dBFS (the drum of issue 36)."""
+    t = np.arange(int(0.4 * sample_rate)) / sample_rate
+    phase = np.cumsum(2 * np.pi * (50 + 70 * np.exp(-t / 0.03)) / sample_rate)
+    hit = np.exp(-t / 0.06) * np.sin(phase)
+    hit *= 10 ** (peak_db / 20) / np.abs(hit).max()
+    audio = np.zeros((channels, frames), dtype=np.float32)
+    for start in range(0, frames, every):
+        n = min(len(hit), frames - start)
+        audio[:, start : start + n] += hit[:n].astype(np.float32)
+    return audio
+
+
 def clicks(channels: int, frames: int, every: int, value: float) -> np.ndarray:
     """A click train: `value` every `every` samples on every channel, from sample 0."""
     audio = np.zeros((channels, frames), dtype=np.float32)

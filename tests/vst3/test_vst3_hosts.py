@@ -19,6 +19,7 @@ from ressort_vst3 import (
     bundle,
     cents,
     clicks,
+    kicks,
     model_state,
     oscillator_frequency,
     peak_frequency,
@@ -41,9 +42,6 @@ def routed_oscillator(source: str) -> str:
     return OSCILLATOR + f"~route in1 {source}\n"
 
 
-#: A sidechain click that strikes the default model (Mesh 15x15: in1 pushes a hammer onto the
-#: membrane; a negative force moves it towards the membrane).
-STRIKE = -0.05
 
 #: The MIDI controllers the VST3 plugin lists as proxies (`VST3_CONTROLLERS` in the plugin).
 VST3_CONTROLLERS = [1, 2, 4, 7, 11, 16, 17, 18, 19, 64, 71, 72, 73, 74, "channel_pressure", "bend"]
@@ -64,6 +62,9 @@ PARAMETERS = [
     "mpe",
     "bend_range_st",
     "velocity_curve",
+    "a4_hz",
+    "sidechain_trigger",
+    "trigger_sensitivity_db",
 ] + [f"macro_{i}" for i in range(1, 17)]
 
 
@@ -108,7 +109,9 @@ def test_pedalboard_loads_the_plugin_with_its_parameters():
 def test_pedalboard_reads_and_sets_parameters_by_value():
     plugin = pedalboard.load_plugin(str(bundle()))
     assert plugin.stiffness == 1.0
-    assert plugin.output_gain_db == 24.0
+    # A new model's level is set by its automatic trim; Output Gain adds to it.
+    assert plugin.output_gain_db == 0.0
+    assert plugin.a4_hz == 440.0
     plugin.stiffness = 4
     assert plugin.stiffness == 4.0
     assert plugin.parameters["stiffness"].raw_value == pytest.approx(0.75, abs=1e-6)
@@ -234,21 +237,23 @@ def test_pedalboard_restores_state_bit_identically_into_a_fresh_instance(preset_
 
 def test_pedalboard_audio_input_strikes_the_model():
     # pedalboard enables the main input and switches the sidechain off where it can: the
-    # plugin runs in its "Effect" layout, and the main input's left channel is @in1.
+    # plugin runs in its "Effect" layout, and the main input's left channel is @in1. A kick at
+    # -6 dBFS strikes the default model (Mesh 15x15) like a medium note, four times a second.
     plugin = pedalboard.load_plugin(str(bundle()))
-    struck = plugin(clicks(2, SR, SR // 10, STRIKE), SR)
+    struck = plugin(kicks(2, SR, SR // 4, SR), SR)
     assert struck.shape == (2, SR)
     assert np.isfinite(struck).all()
     plugin.reset()
-    silent = plugin(clicks(2, SR, SR // 10, 0.0), SR)
+    silent = plugin(np.zeros((2, SR), dtype=np.float32), SR)
     print(f"peak struck {np.abs(struck).max():.4f}, silent input {np.abs(silent).max():.2e}")
     assert np.abs(silent).max() == 0.0
-    assert np.abs(struck).max() > 0.05
-    # Every click strikes: the output rises within 10 ms after each one.
-    for n in range(10):
-        start = n * SR // 10
-        window = struck[0, start : start + SR // 100]
-        assert np.abs(window).max() > 0.01, f"click {n} did not strike"
+    # Like a note (-12 dBFS at velocity 0.8) within 6 dB, below the soft ceiling's knee.
+    assert 0.125 < np.abs(struck).max() < 0.5
+    # Every kick strikes: the output rises within 25 ms after each one.
+    for n in range(4):
+        start = n * SR // 4
+        window = struck[0, start : start + SR // 40]
+        assert np.abs(window).max() > 0.01, f"kick {n} did not strike"
 
 
 # ------------------------------------------------------------------------------------------
@@ -274,21 +279,21 @@ def test_dawdreamer_loads_the_plugin_with_stereo_input_and_output():
     assert len(names) == len(PARAMETERS) + 16 * len(VST3_CONTROLLERS)
 
 
-def test_dawdreamer_sidechain_clicks_strike_the_model():
-    def with_clicks(value):
+def test_dawdreamer_sidechain_kicks_strike_the_model():
+    def with_drum(audio):
         def setup(engine):
             plugin = engine.make_plugin_processor("ressort", str(bundle()))
-            source = engine.make_playback_processor("clicks", clicks(2, SR, SR // 10, value))
-            return [(source, []), (plugin, ["clicks"])]
+            source = engine.make_playback_processor("drum", audio)
+            return [(source, []), (plugin, ["drum"])]
 
         return setup
 
-    struck = render_dawdreamer(with_clicks(STRIKE))
-    silent = render_dawdreamer(with_clicks(0.0))
+    struck = render_dawdreamer(with_drum(kicks(2, SR, SR // 4, SR)))
+    silent = render_dawdreamer(with_drum(np.zeros((2, SR), dtype=np.float32)))
     print(f"peak struck {np.abs(struck).max():.4f}, silent input {np.abs(silent).max():.2e}")
     assert np.isfinite(struck).all()
     assert np.abs(silent).max() == 0.0
-    assert np.abs(struck).max() > 0.05
+    assert 0.125 < np.abs(struck).max() < 0.5
 
 
 def test_dawdreamer_plays_a_preset_and_a_midi_note_at_its_pitch(preset_dir):
