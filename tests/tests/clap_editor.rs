@@ -9,7 +9,7 @@
 //! goes away).
 
 use ressort_tests::screen::{capture, plot_stats, shows_motion, HostWindow, Xvfb};
-use ressort_tests::{state, struck_default, thread_count, Score, TestPlugin};
+use ressort_tests::{state, struck_default, thread_count, Score};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 

@@ -639,10 +639,10 @@ impl Instrument {
                 Event::PitchBend { value, channel } if !(self.controls.mpe && channel != 0) => {
                     self.bend_st = events::bend_semitones(value, self.controls.bend_range_st);
                 }
-                Event::NoteOn { note, .. } => {
-                    if self.current.as_deref().is_some_and(|m| m.bank.is_none()) {
-                        self.note_key = Some(note);
-                    }
+                Event::NoteOn { note, .. }
+                    if self.current.as_deref().is_some_and(|m| m.bank.is_none()) =>
+                {
+                    self.note_key = Some(note);
                 }
                 Event::Controller { cc, value } => {
                     self.controller(cc, value);
