@@ -7,10 +7,14 @@ use std::time::Instant;
 fn main() {
     // The preset names on the command line.
     for name in std::env::args().skip(1) {
-        let text = std::fs::read_to_string(format!("models/{name}.mdl")).expect("a preset in models/");
+        let text =
+            std::fs::read_to_string(format!("models/{name}.mdl")).expect("a preset in models/");
         let mut best = [f64::MAX; 2];
         for _ in 0..3 {
-            for (i, c) in [Conventions::Legacy, Conventions::Musical].into_iter().enumerate() {
+            for (i, c) in [Conventions::Legacy, Conventions::Musical]
+                .into_iter()
+                .enumerate()
+            {
                 let t = Instant::now();
                 let p = prepare_with(&name, &text, 48000.0, c);
                 let s = t.elapsed().as_secs_f64();
@@ -18,6 +22,11 @@ fn main() {
                 best[i] = best[i].min(s);
             }
         }
-        println!("{name:<24} legacy {:.3} s  musical {:.3} s  renders +{:.3} s", best[0], best[1], best[1] - best[0]);
+        println!(
+            "{name:<24} legacy {:.3} s  musical {:.3} s  renders +{:.3} s",
+            best[0],
+            best[1],
+            best[1] - best[0]
+        );
     }
 }

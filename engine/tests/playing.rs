@@ -388,6 +388,42 @@ fn a_bow_sounds_while_its_key_is_held_and_leaves_at_note_off() {
     assert!(sustained.peak_between(SR, 2.5, 3.0) > 0.5 * held);
 }
 
+/// Pressure while a key is held (polyphonic aftertouch here; channel pressure and the CLAP
+/// pressure expression arrive as the same event) drives the bow faster, and the string louder.
+#[test]
+fn pressure_on_a_held_bow_drives_it_harder() {
+    const SR: f64 = 48_000.0;
+    let mut p = Player::new(&preset("bowed-string"), SR);
+    let soft = [(0, Event::note_on(45, 0.3))];
+    let press = Event::Pressure {
+        value: 1.0,
+        channel: 0,
+        note: Some(45),
+        voice_id: None,
+    };
+    let pressed = [soft[0], ((0.8 * SR) as usize, press)];
+    let plain = p.play(Controls::DEFAULT, &soft, None, 1.6);
+    let harder = p.play(Controls::DEFAULT, &pressed, None, 1.6);
+    let before = |t: &Take| db(t.peak_between(SR, 0.5, 0.8));
+    let after = |t: &Take| db(t.peak_between(SR, 1.3, 1.6));
+    println!(
+        "bow at velocity 0.3: {:.1} → {:.1} dBFS alone, {:.1} → {:.1} dBFS with full pressure",
+        before(&plain),
+        after(&plain),
+        before(&harder),
+        after(&harder)
+    );
+    assert_eq!(
+        before(&plain),
+        before(&harder),
+        "nothing changes before the pressure"
+    );
+    assert!(
+        after(&harder) > after(&plain) + 2.0,
+        "full pressure bows louder than velocity 0.3 alone"
+    );
+}
+
 #[test]
 fn a_pluck_plucks_once_per_key() {
     const SR: f64 = 48_000.0;
