@@ -75,21 +75,12 @@ impl Engine {
     /// their heaviest node), for drawing a structure. Macro-internal links are not listed:
     /// they join consecutive nodes of a string and neighbours of a mesh (spec §2.7).
     pub fn links(&self) -> Vec<(u32, u32)> {
-        let i = &self.interactions;
-        [
-            &i.linear,
-            &i.contact,
-            &i.nl_contact,
-            &i.nl_spring2,
-            &i.nl_spring3,
-            &i.nl_spring_damper,
-            &i.pluck,
-            &i.bow,
-        ]
-        .iter()
-        .flat_map(|g| g.a.iter().zip(&g.b))
-        .filter_map(|(&a, &b)| Some((self.display_point(a)?, self.display_point(b)?)))
-        .filter(|(a, b)| a != b)
-        .collect()
+        self.interactions
+            .groups
+            .iter()
+            .flat_map(|g| g.a.iter().zip(&g.b))
+            .filter_map(|(&a, &b)| Some((self.display_point(a)?, self.display_point(b)?)))
+            .filter(|(a, b)| a != b)
+            .collect()
     }
 }

@@ -15,7 +15,7 @@
 
 use crate::engine::{single_law, ArgClass, Group, Proxies, NUM_ARG_CLASSES};
 use crate::engine::{FLUSH_BELOW, FLUSH_INTERVAL};
-use crate::laws;
+use crate::laws::{self, LawKind};
 use crate::spec::ScaleClass;
 use crate::{Engine, ParamError, ParamId};
 
@@ -553,42 +553,43 @@ impl LaneEngine {
         let (x, xp, f) = (&self.x[..], &self.xp[..], &mut self.f[..]);
         // A group's argument column c, sliced to the group's length.
         let col = |g: &Group, c: usize| &args[g.cols[c]..g.cols[c] + g.len()];
-        let g = &it.linear;
+        // Law by law, as `Interactions::step` (a loop over the kinds measured slower there).
+        let g = it.group(LawKind::SpringDamper);
         if g.len() > 0 {
             let (k, z) = (col(g, 0), col(g, 1));
             apply(o, g, x, xp, f, &Linear { k, z });
         }
-        let g = &it.contact;
+        let g = it.group(LawKind::Contact);
         if g.len() > 0 {
             let (k, z, t) = (col(g, 0), col(g, 1), col(g, 2));
             apply(o, g, x, xp, f, &Contact { k, z, t });
         }
-        let g = &it.nl_contact;
+        let g = it.group(LawKind::NlContact);
         if g.len() > 0 {
             let (s, c, k, z, t) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3), col(g, 4));
             apply(o, g, x, xp, f, &NlContact { s, c, k, z, t });
         }
-        let g = &it.nl_spring2;
+        let g = it.group(LawKind::NlSpring2);
         if g.len() > 0 {
             let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
             apply(o, g, x, xp, f, &NlSpring2 { k, q, z });
         }
-        let g = &it.nl_spring3;
+        let g = it.group(LawKind::NlSpring3);
         if g.len() > 0 {
             let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
             apply(o, g, x, xp, f, &NlSpring3 { k, q, z });
         }
-        let g = &it.nl_spring_damper;
+        let g = it.group(LawKind::NlSpringDamper);
         if g.len() > 0 {
             let (s, c, k, z) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3));
             apply(o, g, x, xp, f, &NlSpringDamper { s, c, k, z });
         }
-        let g = &it.pluck;
+        let g = it.group(LawKind::Pluck);
         if g.len() > 0 {
             let (k, scale, z) = (col(g, 0), col(g, 1), col(g, 2));
             apply(o, g, x, xp, f, &Pluck { k, scale, z });
         }
-        let g = &it.bow;
+        let g = it.group(LawKind::Bow);
         if g.len() > 0 {
             let (z, sc, sm) = (col(g, 0), col(g, 1), col(g, 2));
             let law = |i: usize, l: usize, _dx, dv| laws::nl_bow(dv, z[i][l], sc[i][l], sm[i][l]);

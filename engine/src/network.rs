@@ -13,20 +13,13 @@
 //! §2.7), which enter the update law X[n+1] = (2 − (K+Z)/M)·X[n] + (Z/M − 1)·X[n−1] + F/M
 //! exactly as a spring-damper to a fixed point.
 //!
-//! **How each nonlinear law enters** (Δx and Δv of spec §1.3):
-//!
-//! | law | [`Valuation::Bound`] (stability, §5.2) | [`Valuation::Rest`] (modes, at rest, Δv = 0) |
-//! |---|---|---|
-//! | `contact` | engaged: (K, Z) | (K, Z) if Δx > −θ (closed at rest), else open: nothing |
-//! | `nlContact` | bounded tangent k, or 3k − 2s below the tipping point | if d = Δx + θ > 0, the slope of the bounded cubic at d, else nothing |
-//! | `nlSpring2`/`nlSpring3` | linear K | tangent K + 2Q·\|Δx\| / K + 3Q·Δx² (K at Δx = 0) |
-//! | `nlSpringDamper` | bounded tangent, damping Z + 0.3k | the slope at Δx, damping Z (Z + 0.3k in the bounded region) |
-//! | `nlPluck` | 0.9·\|K\|, Z | small-displacement slope −0.9K (no damping) for \|Δx\| < scale/10, K/10 with Z in the outer band, nothing beyond `scale` |
-//! | `nlBow` | stick slope in Z: ⅔·Z, or 0.63·e^½·Z (smooth) | the same stick slope (the bow rests on the string: Δv = 0) |
+//! Each law enters by its linear stand-in, [`LawKind::linearise`] (the table is in
+//! [`crate::laws::linear`]).
 
 use crate::engine::{Engine, Group};
 use crate::info::PointKind;
-use crate::laws::PLUCK_SHARPNESS;
+use crate::laws::linear::{BoundNote, Linear};
+use crate::laws::LawKind;
 use crate::stability::StabilityWarning;
 
 /// How nonlinear laws are linearised.
@@ -104,21 +97,6 @@ pub(crate) fn endpoint_nodes(e: &Engine, p: u32) -> impl Iterator<Item = (usize,
         .map(|(node, w)| (node as usize, w))
 }
 
-/// The tangent of the bounded cubic of `nlContact`/`nlSpringDamper` at d (spec §2.4.2,
-/// §2.5.3): s for c = 0, k on the bounded branch, s + 3c·d² in the cubic region. Returns the
-/// slope and whether d is in the bounded region.
-fn bounded_cubic_slope(d: f64, s: f64, c: f64, k: f64) -> (f64, bool) {
-    if c == 0.0 {
-        (s, false)
-    } else if s >= k || c < 0.0 {
-        (k, true)
-    } else if c * d * d <= k - s {
-        (s + 3.0 * c * d * d, false)
-    } else {
-        (k, true)
-    }
-}
-
 impl Network {
     /// Walks the compiled model once (spec §5.2 and §5.5).
     pub(crate) fn walk(e: &Engine, valuation: Valuation<'_>) -> Network {
@@ -160,147 +138,42 @@ impl Network {
             }
         };
 
-        let g = &ix.linear;
-        for i in 0..g.len() {
-            push(g, i, col(g, 0, i), col(g, 1, i), &mut net.links);
-        }
-        let g = &ix.contact;
-        for i in 0..g.len() {
-            let (k, z, t) = (col(g, 0, i), col(g, 1, i), col(g, 2, i));
-            // Engaged iff Δx > −θ (spec §2.4.1); counted engaged by the bound.
-            if rest_dx(g, i).is_none_or(|dx| dx > -t) {
-                push(g, i, k, z, &mut net.links);
-            } else {
-                net.open_contacts.push((g.a[i], g.b[i]));
-            }
-        }
-        let g = &ix.nl_contact;
-        for i in 0..g.len() {
-            let (s, c, k, z, t) = (
-                col(g, 0, i),
-                col(g, 1, i),
-                col(g, 2, i),
-                col(g, 3, i),
-                col(g, 4, i),
-            );
-            let (k, c) = if k < s { (s, 0.0) } else { (k, c) };
-            match rest_dx(g, i) {
-                None => {
-                    if c < 0.0 {
-                        net.warnings.push(StabilityWarning::NegativeCubic {
-                            label: endpoints(g, i),
-                            keyword: "nlContact",
-                            element: g.elements[i],
-                        });
-                    }
-                    let kb = if c == 0.0 {
-                        s
-                    } else if s >= k || c < 0.0 {
-                        k
-                    } else {
-                        3.0 * k - 2.0 * s
-                    };
-                    push(g, i, kb, z, &mut net.links);
-                }
-                Some(dx) => {
-                    let d = dx + t;
-                    if d > 0.0 {
-                        push(g, i, bounded_cubic_slope(d, s, c, k).0, z, &mut net.links);
-                    } else {
-                        net.open_contacts.push((g.a[i], g.b[i]));
-                    }
-                }
-            }
-        }
-        for (g, keyword, power) in [
-            (&ix.nl_spring2, "nlSpring2", 2),
-            (&ix.nl_spring3, "nlSpring3", 3),
-        ] {
+        // Every law by its linear stand-in (`LawKind::linearise`).
+        let mut a = [0.0; LawKind::MAX_ARITY];
+        for kind in LawKind::ALL {
+            let g = ix.group(kind);
+            let a = &mut a[..kind.arity()];
             for i in 0..g.len() {
-                let (k, q, z) = (col(g, 0, i), col(g, 1, i), col(g, 2, i));
-                match rest_dx(g, i) {
-                    None => {
-                        if q != 0.0 {
-                            net.warnings.push(StabilityWarning::Unbounded {
-                                label: endpoints(g, i),
-                                keyword,
-                                element: g.elements[i],
-                            });
-                        }
-                        push(g, i, k, z, &mut net.links);
-                    }
-                    // d/dΔx of K·Δx + Q·sgn(Δx)·Δx² or K·Δx + Q·Δx³ (spec §2.5.1–2).
-                    Some(dx) => {
-                        let slope = if power == 2 {
-                            k + 2.0 * q * dx.abs()
-                        } else {
-                            k + 3.0 * q * dx * dx
-                        };
-                        push(g, i, slope, z, &mut net.links);
-                    }
+                for (c, v) in a.iter_mut().enumerate() {
+                    *v = col(g, c, i);
+                }
+                let note = match valuation {
+                    Valuation::Bound => kind.bound_note(a),
+                    Valuation::Rest(_) => None,
+                };
+                if let Some(note) = note {
+                    let (label, element) = (endpoints(g, i), g.elements[i]);
+                    let keyword = kind.row().keyword;
+                    net.warnings.push(match note {
+                        BoundNote::NegativeCubic => StabilityWarning::NegativeCubic {
+                            label,
+                            keyword,
+                            element,
+                        },
+                        BoundNote::Unbounded => StabilityWarning::Unbounded {
+                            label,
+                            keyword,
+                            element,
+                        },
+                        BoundNote::WeakBound => StabilityWarning::WeakBound { label, element },
+                    });
+                }
+                match kind.linearise(a, rest_dx(g, i)) {
+                    Linear::Link { k, z } => push(g, i, k, z, &mut net.links),
+                    Linear::Open => net.open_contacts.push((g.a[i], g.b[i])),
+                    Linear::Free => {}
                 }
             }
-        }
-        let g = &ix.nl_spring_damper;
-        for i in 0..g.len() {
-            let (s, c, k, z) = (col(g, 0, i), col(g, 1, i), col(g, 2, i), col(g, 3, i));
-            let (kb, zb) = match rest_dx(g, i) {
-                None => {
-                    if c < 0.0 {
-                        net.warnings.push(StabilityWarning::NegativeCubic {
-                            label: endpoints(g, i),
-                            keyword: "nlSpringDamper",
-                            element: g.elements[i],
-                        });
-                    } else if c != 0.0 && k < s {
-                        net.warnings.push(StabilityWarning::WeakBound {
-                            label: endpoints(g, i),
-                            element: g.elements[i],
-                        });
-                    }
-                    if c == 0.0 {
-                        (s, z)
-                    } else if s >= k || c < 0.0 {
-                        (k, z + 0.3 * k)
-                    } else {
-                        (3.0 * k - 2.0 * s, z + 0.3 * k)
-                    }
-                }
-                Some(dx) => match bounded_cubic_slope(dx, s, c, k) {
-                    (slope, true) => (slope, z + 0.3 * k),
-                    (slope, false) => (slope, z),
-                },
-            };
-            push(g, i, kb, zb, &mut net.links);
-        }
-        let g = &ix.pluck;
-        for i in 0..g.len() {
-            let (k, scale, z) = (col(g, 0, i), col(g, 1, i), col(g, 2, i));
-            match rest_dx(g, i) {
-                None => push(g, i, 0.9 * k.abs(), z, &mut net.links),
-                // The tent of spec §2.6.1: slope −(K − K/σ) inside d_t, K/σ with Z outside.
-                Some(dx) => {
-                    let d_t = scale / PLUCK_SHARPNESS;
-                    if dx.abs() < d_t {
-                        push(g, i, -(k - k / PLUCK_SHARPNESS), 0.0, &mut net.links);
-                    } else if dx.abs() < scale {
-                        push(g, i, k / PLUCK_SHARPNESS, z, &mut net.links);
-                    }
-                }
-            }
-        }
-        let g = &ix.bow;
-        for i in 0..g.len() {
-            let (z, scale, smooth) = (col(g, 0, i), col(g, 1, i), col(g, 2, i));
-            // The slope of the friction law at Δv = 0 (spec §2.6.2); no force for scale ≤ 0.
-            let stick = if !(scale > 0.0) {
-                0.0
-            } else if smooth >= 1.0 {
-                0.63 * 0.5f64.exp() * z
-            } else {
-                2.0 / 3.0 * z
-            };
-            push(g, i, 0.0, stick, &mut net.links);
         }
 
         // Single masses: M and the osc terms (spec §2.1).

@@ -7,6 +7,7 @@
 //! into flat arrays.
 
 use crate::expr::Expr;
+use crate::laws::LawKind;
 
 mod builder;
 mod host;
@@ -221,19 +222,96 @@ pub enum Law {
 }
 
 impl Law {
+    /// The law's kind: its row of the table of laws ([`LawKind::row`]). `spring` and
+    /// `damper` are spring-dampers with one column written.
+    pub fn kind(&self) -> LawKind {
+        match self {
+            Law::Spring { .. } | Law::Damper { .. } | Law::SpringDamper { .. } => {
+                LawKind::SpringDamper
+            }
+            Law::Contact { .. } => LawKind::Contact,
+            Law::NlContact { .. } => LawKind::NlContact,
+            Law::NlSpring2 { .. } => LawKind::NlSpring2,
+            Law::NlSpring3 { .. } => LawKind::NlSpring3,
+            Law::NlSpringDamper { .. } => LawKind::NlSpringDamper,
+            Law::NlPluck { .. } => LawKind::Pluck,
+            Law::NlBow { .. } => LawKind::Bow,
+        }
+    }
+
+    /// The law's arguments in its kind's column order ([`crate::laws::LawRow::columns`]), with `zero` for
+    /// a column the form leaves out (the Z of `spring`, the K of `damper`) and past the
+    /// kind's own columns.
+    pub fn columns<'a>(&'a self, zero: &'a Expr) -> [&'a Expr; LawKind::MAX_ARITY] {
+        let z = zero;
+        match self {
+            Law::Spring { k } => [k, z, z, z, z],
+            Law::Damper { z: d } => [z, d, z, z, z],
+            Law::SpringDamper { k, z: d } => [k, d, z, z, z],
+            Law::Contact { k, z: d, thresh } => [k, d, thresh, z, z],
+            Law::NlContact {
+                k,
+                q,
+                klim,
+                z: d,
+                thresh,
+            } => [k, q, klim, d, thresh],
+            Law::NlSpring2 { k, q, z: d } | Law::NlSpring3 { k, q, z: d } => [k, q, d, z, z],
+            Law::NlSpringDamper { k, q, klim, z: d } => [k, q, klim, d, z],
+            Law::NlPluck { k, scale, z: d } => [k, scale, d, z, z],
+            Law::NlBow {
+                z: d,
+                scale,
+                smooth,
+            } => [d, scale, smooth, z, z],
+        }
+    }
+
+    /// The law of `kind` written with its own keyword, from its columns in order (the ones
+    /// past the kind's arity are ignored).
+    pub fn from_columns(kind: LawKind, columns: [Expr; LawKind::MAX_ARITY]) -> Law {
+        let [a, b, c, d, e] = columns;
+        match kind {
+            LawKind::SpringDamper => Law::SpringDamper { k: a, z: b },
+            LawKind::Contact => Law::Contact {
+                k: a,
+                z: b,
+                thresh: c,
+            },
+            LawKind::NlContact => Law::NlContact {
+                k: a,
+                q: b,
+                klim: c,
+                z: d,
+                thresh: e,
+            },
+            LawKind::NlSpring2 => Law::NlSpring2 { k: a, q: b, z: c },
+            LawKind::NlSpring3 => Law::NlSpring3 { k: a, q: b, z: c },
+            LawKind::NlSpringDamper => Law::NlSpringDamper {
+                k: a,
+                q: b,
+                klim: c,
+                z: d,
+            },
+            LawKind::Pluck => Law::NlPluck {
+                k: a,
+                scale: b,
+                z: c,
+            },
+            LawKind::Bow => Law::NlBow {
+                z: a,
+                scale: b,
+                smooth: c,
+            },
+        }
+    }
+
     /// The canonical keyword of the law.
     pub fn keyword(&self) -> &'static str {
         match self {
             Law::Spring { .. } => "spring",
             Law::Damper { .. } => "damper",
-            Law::SpringDamper { .. } => "springDamper",
-            Law::Contact { .. } => "contact",
-            Law::NlContact { .. } => "nlContact",
-            Law::NlSpring2 { .. } => "nlSpring2",
-            Law::NlSpring3 { .. } => "nlSpring3",
-            Law::NlSpringDamper { .. } => "nlSpringDamper",
-            Law::NlPluck { .. } => "nlPluck",
-            Law::NlBow { .. } => "nlBow",
+            _ => self.kind().row().keyword,
         }
     }
 

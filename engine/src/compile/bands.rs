@@ -19,16 +19,12 @@
 
 use super::kinds::{LinkGroups, Row};
 use crate::kernels::links::{find_bands, MIN_CHAIN};
+use crate::laws::LawKind;
 
 /// How many of a link list's links the engine runs in bands.
 fn banded(a: &[u32], b: &[u32]) -> usize {
     find_bands(a, b).0.iter().map(|c| c.1 as usize).sum()
 }
-
-/// Per interaction group (in `kinds::law_row` order): the law is odd, f(−Δx, −Δv) = −f(Δx, Δv)
-/// exactly in floating point (negation is exact and round-to-nearest is symmetric), so a link
-/// written (b, a) applies exactly the forces of (a, b): spring-dampers, nlSpring2, nlSpring3.
-const ODD_LAWS: [bool; 8] = [true, false, false, true, true, false, false, false];
 
 /// The band order of a link list: the positions of the links, bands first (by direction, d,
 /// then first point), then every other link in list order; and, per position, whether the
@@ -81,7 +77,8 @@ impl LinkGroups<'_> {
     /// Reorders each group into bands, unless its links are all banded as written or the
     /// sorted order bands fewer (see the module's documentation).
     pub fn order_into_bands(&mut self) {
-        for (rows, odd) in self.groups.iter_mut().zip(ODD_LAWS) {
+        for (rows, kind) in self.groups.iter_mut().zip(LawKind::ALL) {
+            let odd = kind.row().odd;
             let n = rows.len();
             if n < MIN_CHAIN {
                 continue;

@@ -4,15 +4,16 @@
 //! connection-point coordinates, then each interaction group's columns.
 
 use super::context::Cx;
-use super::kinds::{Kinds, LAW_COLUMNS};
+use super::kinds::Kinds;
 use super::points::Numbering;
 use super::Rate;
 use crate::engine::{
-    ArgClass, Group, InitRule, InitRun, Interactions, LineMacro, MacroSlots, Macros, MeshMacro,
+    ArgClass, InitRule, InitRun, Interactions, LineMacro, MacroSlots, Macros, MeshMacro,
     SingleMasses,
 };
 use crate::expr::Expr;
 use crate::kernels::masses::Update;
+use crate::laws::LawKind;
 use crate::spec::{ElementKind, MacroKind, SampleRateMode, REFERENCE_SAMPLE_RATE_HZ};
 
 /// The bound kinds, ready to run.
@@ -253,17 +254,14 @@ impl<'a> Cx<'a> {
     /// Interaction groups: one column per argument, one row per link.
     fn bind_links(&mut self, kinds: &Kinds<'a>) -> Interactions {
         let mut interactions = Interactions::default();
-        let targets: [&mut Group; 8] = [
-            &mut interactions.linear,
-            &mut interactions.contact,
-            &mut interactions.nl_contact,
-            &mut interactions.nl_spring2,
-            &mut interactions.nl_spring3,
-            &mut interactions.nl_spring_damper,
-            &mut interactions.pluck,
-            &mut interactions.bow,
-        ];
-        for ((rows, group), ncols) in kinds.links.groups.iter().zip(targets).zip(LAW_COLUMNS) {
+        for ((rows, group), kind) in kinds
+            .links
+            .groups
+            .iter()
+            .zip(interactions.groups_mut())
+            .zip(LawKind::ALL)
+        {
+            let ncols = kind.arity();
             let n = rows.len();
             group.cols = (0..ncols).map(|c| self.args.len() + c * n).collect();
             let new_len = self.args.len() + ncols * n;

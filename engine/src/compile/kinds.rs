@@ -12,10 +12,11 @@ use super::points::Numbering;
 use crate::engine::{ArgClass, Route};
 use crate::expr::Expr;
 use crate::info::{InputUse, OutputUse};
+use crate::laws::LawKind;
 use crate::spec::{ElementKind, Endpoint, Law};
 
 /// A link (an interaction element) of one law: its two points and its argument expressions,
-/// in the law's column order (the first `LAW_COLUMNS[group]` of `args`).
+/// in the law's column order (the first [`LawKind::arity`] of `args`).
 pub(super) struct Row<'a> {
     pub a: u32,
     pub b: u32,
@@ -23,27 +24,19 @@ pub(super) struct Row<'a> {
     pub element: usize,
 }
 
-/// The most argument columns a law has.
-const MAX_LAW_COLUMNS: usize = 5;
-
-/// A law's argument expressions and their classes, padded with zeros to [`MAX_LAW_COLUMNS`].
-pub(super) type LawArgs<'a> = [(&'a Expr, ArgClass); MAX_LAW_COLUMNS];
-
-/// The number of interaction groups, one per law family, in [`law_row`] order.
-pub(super) const NUM_LAW_GROUPS: usize = 8;
-
-/// The number of argument columns of each interaction group, in [`law_row`] order.
-pub(super) const LAW_COLUMNS: [usize; NUM_LAW_GROUPS] = [2, 3, 5, 3, 3, 4, 3, 3];
+/// A law's argument expressions and their classes, padded with zeros to
+/// [`LawKind::MAX_ARITY`].
+pub(super) type LawArgs<'a> = [(&'a Expr, ArgClass); LawKind::MAX_ARITY];
 
 /// The links of a model by law group, each group in script order (until `bands` reorders it).
 #[derive(Default)]
 pub(super) struct LinkGroups<'a> {
-    pub groups: [Vec<Row<'a>>; NUM_LAW_GROUPS],
+    pub groups: [Vec<Row<'a>>; LawKind::COUNT],
 }
 
 impl<'a> LinkGroups<'a> {
-    fn push(&mut self, group: usize, row: Row<'a>) {
-        self.groups[group].push(row);
+    fn push(&mut self, kind: LawKind, row: Row<'a>) {
+        self.groups[kind.index()].push(row);
     }
 }
 
@@ -140,10 +133,10 @@ impl<'a> Cx<'a> {
             num_interactions += 1;
             let pa = self.endpoint(a, i, proxy_base);
             let pb = self.endpoint(b, i, proxy_base);
-            let (group, args) = law_row(law);
+            let (kind, args) = law_row(law);
             if let (Some(a), Some(b)) = (pa, pb) {
                 links.push(
-                    group,
+                    kind,
                     Row {
                         a,
                         b,
@@ -218,30 +211,19 @@ impl<'a> Cx<'a> {
     }
 }
 
-/// The interaction group index and argument list of a law.
-fn law_row(law: &Law) -> (usize, LawArgs<'_>) {
-    use ArgClass::{Damping as Z, None as N, Stiffness as K, VelocityScale as V};
+/// The law of a spec element and its argument expressions in the law's column order, with
+/// the classes of the law's row (a missing column, the K of a `damper` or the Z of a `spring`,
+/// is a zero).
+fn law_row(law: &Law) -> (LawKind, LawArgs<'_>) {
     static ZERO: Expr = Expr::Num(0.0);
-    let zero = &ZERO;
-    let pad = (zero, N);
-    match law {
-        Law::Spring { k } => (0, [(k, K), (zero, Z), pad, pad, pad]),
-        Law::Damper { z } => (0, [(zero, K), (z, Z), pad, pad, pad]),
-        Law::SpringDamper { k, z } => (0, [(k, K), (z, Z), pad, pad, pad]),
-        Law::Contact { k, z, thresh } => (1, [(k, K), (z, Z), (thresh, N), pad, pad]),
-        Law::NlContact {
-            k,
-            q,
-            klim,
-            z,
-            thresh,
-        } => (2, [(k, K), (q, K), (klim, K), (z, Z), (thresh, N)]),
-        Law::NlSpring2 { k, q, z } => (3, [(k, K), (q, K), (z, Z), pad, pad]),
-        Law::NlSpring3 { k, q, z } => (4, [(k, K), (q, K), (z, Z), pad, pad]),
-        Law::NlSpringDamper { k, q, klim, z } => (5, [(k, K), (q, K), (klim, K), (z, Z), pad]),
-        Law::NlPluck { k, scale, z } => (6, [(k, K), (scale, N), (z, Z), pad, pad]),
-        Law::NlBow { z, scale, smooth } => (7, [(z, Z), (scale, V), (smooth, N), pad, pad]),
-    }
+    let kind = law.kind();
+    let exprs = law.columns(&ZERO);
+    let columns = kind.row().columns;
+    let args = std::array::from_fn(|c| {
+        let class = columns.get(c).map_or(ArgClass::None, |col| col.class);
+        (exprs[c], class)
+    });
+    (kind, args)
 }
 
 /// The text of an endpoint, for metadata (`@h`, `[@s 0.3]`).

@@ -14,10 +14,11 @@
 //! due), so a channel the block does not have reads `Frame::zero` or writes `Frame::sink`,
 //! each that long, and every channel is addressed as base + 8·j.
 
-use super::laws::{self, Callees, Law};
+use super::laws::{self, Callees};
 use super::{Frame, NativeCode, BAIL, MAX_ELEMENTS};
 use crate::engine::{Engine, FLUSH_INTERVAL};
 use crate::kernels::links::Group;
+use crate::laws::LawKind;
 use cranelift_codegen::ir::condcodes::IntCC;
 use cranelift_codegen::ir::{
     types, AbiParam, Block, InstBuilder, MemFlags, Signature, UserFuncName, Value,
@@ -33,26 +34,17 @@ use std::sync::Mutex;
 /// the next instead of moving at the end of each.
 const UNROLL: usize = 2;
 
-/// The groups of the engine's stage 4, in their order, with their laws.
-pub(super) fn groups(engine: &Engine) -> [(Law, &Group); 8] {
-    let i = &engine.interactions;
-    [
-        (Law::SpringDamper, &i.linear),
-        (Law::Contact, &i.contact),
-        (Law::NlContact, &i.nl_contact),
-        (Law::NlSpring2, &i.nl_spring2),
-        (Law::NlSpring3, &i.nl_spring3),
-        (Law::NlSpringDamper, &i.nl_spring_damper),
-        (Law::Pluck, &i.pluck),
-        (Law::Bow, &i.bow),
-    ]
+/// The groups of the engine's stage 4, in their order, with their laws: every law of
+/// [`LawKind::ALL`], so the native code covers every link of the model.
+pub(super) fn groups(engine: &Engine) -> impl Iterator<Item = (LawKind, &Group)> {
+    engine.interactions.by_law()
 }
 
 /// Whether `engine` is a model this compiles: single masses, avatars and links only, no
 /// audio-rate parameter, small enough, every index inside the state.
 pub(super) fn fits(engine: &Engine) -> bool {
     let n = engine.points.x.len();
-    let links: usize = groups(engine).iter().map(|(_, g)| g.len()).sum();
+    let links: usize = groups(engine).map(|(_, g)| g.len()).sum();
     let inside = |p: u32| (p as usize) < n;
     let m = &engine.macros;
     m.lines.is_empty()
@@ -74,7 +66,7 @@ pub(super) fn fits(engine: &Engine) -> bool {
             .frc_outputs
             .iter()
             .all(|&(_, start, len)| (start + len) as usize <= engine.frc_sources.len())
-        && groups(engine).iter().all(|(law, g)| {
+        && groups(engine).all(|(law, g)| {
             g.cols.len() == law.arity()
                 && g.a.iter().chain(&g.b).all(|&p| inside(p))
                 && g.cols.iter().all(|&c| c + g.len() <= engine.args.len())

@@ -11,38 +11,7 @@ use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{types, InstBuilder, SigRef, Value};
 use cranelift_frontend::FunctionBuilder;
 
-/// The law of one interaction group, in `Interactions::groups_mut` order.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Law {
-    /// spring, damper, springDamper: (K, Z).
-    SpringDamper,
-    /// (K, Z, θ).
-    Contact,
-    /// (s, c, k, Z, θ).
-    NlContact,
-    /// (K, Q, Z).
-    NlSpring2,
-    /// (K, Q, Z).
-    NlSpring3,
-    /// (s, c, k, Z).
-    NlSpringDamper,
-    /// (K, scale, Z).
-    Pluck,
-    /// (Z, scale, smooth).
-    Bow,
-}
-
-impl Law {
-    /// How many argument columns the law reads.
-    pub fn arity(self) -> usize {
-        match self {
-            Law::SpringDamper => 2,
-            Law::Contact | Law::NlSpring2 | Law::NlSpring3 | Law::Pluck | Law::Bow => 3,
-            Law::NlSpringDamper => 4,
-            Law::NlContact => 5,
-        }
-    }
-}
+use crate::laws::LawKind;
 
 /// What a law's code needs besides the builder: the signature of `exp` (for the bow) and its
 /// address.
@@ -60,21 +29,21 @@ pub(crate) extern "C" fn exp(x: f64) -> f64 {
 /// Emits `law(Δx, Δv, args)` and returns the force f (the caller applies F₁ −= f, F₂ += f).
 pub(crate) fn emit(
     b: &mut FunctionBuilder,
-    law: Law,
+    law: LawKind,
     dx: Value,
     dv: Value,
     a: &[Value],
     callees: Callees,
 ) -> Value {
     match law {
-        Law::SpringDamper => spring_damper(b, dx, dv, a[0], a[1]),
-        Law::Contact => contact(b, dx, dv, a[0], a[1], a[2]),
-        Law::NlContact => nl_contact(b, dx, dv, a[0], a[1], a[2], a[3], a[4]),
-        Law::NlSpring2 => nl_spring2(b, dx, dv, a[0], a[1], a[2]),
-        Law::NlSpring3 => nl_spring3(b, dx, dv, a[0], a[1], a[2]),
-        Law::NlSpringDamper => nl_spring_damper(b, dx, dv, a[0], a[1], a[2], a[3]),
-        Law::Pluck => nl_pluck(b, dx, dv, a[0], a[1], a[2]),
-        Law::Bow => nl_bow(b, dv, a[0], a[1], a[2], callees),
+        LawKind::SpringDamper => spring_damper(b, dx, dv, a[0], a[1]),
+        LawKind::Contact => contact(b, dx, dv, a[0], a[1], a[2]),
+        LawKind::NlContact => nl_contact(b, dx, dv, a[0], a[1], a[2], a[3], a[4]),
+        LawKind::NlSpring2 => nl_spring2(b, dx, dv, a[0], a[1], a[2]),
+        LawKind::NlSpring3 => nl_spring3(b, dx, dv, a[0], a[1], a[2]),
+        LawKind::NlSpringDamper => nl_spring_damper(b, dx, dv, a[0], a[1], a[2], a[3]),
+        LawKind::Pluck => nl_pluck(b, dx, dv, a[0], a[1], a[2]),
+        LawKind::Bow => nl_bow(b, dv, a[0], a[1], a[2], callees),
     }
 }
 
@@ -375,7 +344,7 @@ mod tests {
     type LawFn = unsafe extern "C" fn(f64, f64, f64, f64, f64, f64, f64) -> f64;
 
     /// Compiles `law` alone as `fn(Δx, Δv, a0 … a4) -> f`.
-    fn compile_law(law: Law) -> (JITModule, LawFn) {
+    fn compile_law(law: LawKind) -> (JITModule, LawFn) {
         let isa = isa().expect("this CPU has a Cranelift back end");
         let mut module = JITModule::new(JITBuilder::with_isa(isa, default_libcall_names()));
         let mut ctx = Context::new();
@@ -420,7 +389,7 @@ mod tests {
         a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
     }
 
-    fn compare(law: Law, scalar: impl Fn(f64, f64, &[f64]) -> f64) {
+    fn compare(law: LawKind, scalar: impl Fn(f64, f64, &[f64]) -> f64) {
         let (module, f) = compile_law(law);
         let mut picks = Picks(0x9e37_79b9_7f4a_7c15);
         let mut mismatches = 0;
@@ -443,25 +412,25 @@ mod tests {
 
     #[test]
     fn every_law_equals_the_scalar_law() {
-        compare(Law::SpringDamper, |dx, dv, a| {
+        compare(LawKind::SpringDamper, |dx, dv, a| {
             laws::spring_damper(dx, dv, a[0], a[1])
         });
-        compare(Law::Contact, |dx, dv, a| {
+        compare(LawKind::Contact, |dx, dv, a| {
             laws::contact(dx, dv, a[0], a[1], a[2])
         });
-        compare(Law::NlContact, |dx, dv, a| {
+        compare(LawKind::NlContact, |dx, dv, a| {
             laws::nl_contact(dx, dv, a[0], a[1], a[2], a[3], a[4])
         });
-        compare(Law::NlSpring2, |dx, dv, a| {
+        compare(LawKind::NlSpring2, |dx, dv, a| {
             laws::nl_spring2(dx, dv, a[0], a[1], a[2])
         });
-        compare(Law::NlSpring3, |dx, dv, a| {
+        compare(LawKind::NlSpring3, |dx, dv, a| {
             laws::nl_spring3(dx, dv, a[0], a[1], a[2])
         });
-        compare(Law::NlSpringDamper, |dx, dv, a| {
+        compare(LawKind::NlSpringDamper, |dx, dv, a| {
             laws::nl_spring_damper(dx, dv, a[0], a[1], a[2], a[3])
         });
-        compare(Law::Pluck, |dx, dv, a| {
+        compare(LawKind::Pluck, |dx, dv, a| {
             laws::nl_pluck(dx, dv, a[0], a[1], a[2])
         });
     }
@@ -469,8 +438,10 @@ mod tests {
     /// The bow, both profiles: `smooth` drawn from 0, 1 and the picks.
     #[test]
     fn the_bow_equals_the_scalar_law() {
-        compare(Law::Bow, |_dx, dv, a| laws::nl_bow(dv, a[0], a[1], a[2]));
-        let (module, f) = compile_law(Law::Bow);
+        compare(LawKind::Bow, |_dx, dv, a| {
+            laws::nl_bow(dv, a[0], a[1], a[2])
+        });
+        let (module, f) = compile_law(LawKind::Bow);
         let mut picks = Picks(7);
         for i in 0..20_000 {
             let (dv, z, scale) = (picks.next() * 1e-3, picks.next(), picks.next().abs());

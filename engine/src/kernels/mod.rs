@@ -56,6 +56,7 @@ pub(crate) fn arch_for(macros: &macros::Macros) -> pulp::Arch {
 #[cfg(test)]
 mod tests {
     use super::masses::Update;
+    use crate::laws::LawKind;
     use crate::{compile, parse, CompileOptions};
 
     /// A band of links (a string written element by element, the rows of a mesh, the links
@@ -169,7 +170,12 @@ mod tests {
             input[0] = 1.0;
             let mut out = vec![0.0; 4096];
             e.process(4096, &input, &mut out);
-            assert!(e.interactions.linear.chains.iter().any(|c| c.1 >= 64));
+            assert!(e
+                .interactions
+                .group(LawKind::SpringDamper)
+                .chains
+                .iter()
+                .any(|c| c.1 >= 64));
             out.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
         };
         let forward = render(string(false));
@@ -214,7 +220,7 @@ mod tests {
         let run = |links: &[(usize, usize)]| {
             let spec = parse(&mesh(links)).spec.expect("parses");
             let mut e = compile(&spec, &kernels_at(48_000.0)).expect("compiles");
-            let g = &e.interactions.linear;
+            let g = &e.interactions.group(LawKind::SpringDamper);
             let banded: u32 = g.chains.iter().map(|c| c.1).sum();
             assert_eq!(banded as usize, g.len(), "every link in a band");
             let order: Vec<(u32, u32)> = g.a.iter().copied().zip(g.b.iter().copied()).collect();
@@ -434,7 +440,11 @@ mod tests {
         let mut chained = compile(&spec, &kernels_at(44_100.0)).expect("compiles");
         let mut reference = chained.clone();
         scatter_only(&mut reference);
-        reference.interactions.linear.uniform.clear();
+        reference
+            .interactions
+            .group_mut(LawKind::SpringDamper)
+            .uniform
+            .clear();
         let k2 = chained.param_id("K2").unwrap();
         let frames = 1024;
         let mut input = vec![0.0; frames];
@@ -449,7 +459,7 @@ mod tests {
             chained.set_class_gain(crate::ScaleClass::Stiffness, gains[block]);
             reference.set_class_gain(crate::ScaleClass::Stiffness, gains[block]);
             chained.apply_pending_changes();
-            let linear = &chained.interactions.linear;
+            let linear = &chained.interactions.group(LawKind::SpringDamper);
             assert_eq!(linear.chains.len(), 1, "{:?}", linear.chains);
             assert!(linear.chains[0].1 as usize >= 64);
             assert_eq!(linear.uniform, [value == 0.1], "block {block}");
@@ -509,7 +519,6 @@ mod tests {
             let mut groups = e.interactions.clone();
             let sets: Vec<Vec<bool>> = groups
                 .groups_mut()
-                .iter()
                 .filter(|g| !g.sets.is_empty())
                 .map(|g| g.sets.clone())
                 .collect();
@@ -586,17 +595,21 @@ mod tests {
     fn chain_and_scatter_agree(text: &str, widest: u32) -> bool {
         let spec = parse(text).spec.expect("parses");
         let mut chained = compile(&spec, &kernels_at(48_000.0)).expect("compiles");
-        let bands = &chained.interactions.linear.chains;
+        let bands = &chained.interactions.group(LawKind::SpringDamper).chains;
         assert!(bands.iter().any(|b| b.2 == widest), "{bands:?}");
         // Every link of these models is in a band, whichever way it is written.
         let in_bands: u32 = bands.iter().map(|b| b.1).sum();
         assert!(
-            in_bands as usize + 3 >= chained.interactions.linear.len(),
+            in_bands as usize + 3 >= chained.interactions.group(LawKind::SpringDamper).len(),
             "{bands:?}"
         );
         let mut reference = chained.clone();
         scatter_only(&mut reference);
-        let merged = chained.interactions.linear.rows_uniform.contains(&true);
+        let merged = chained
+            .interactions
+            .group(LawKind::SpringDamper)
+            .rows_uniform
+            .contains(&true);
         let frames = 4096;
         let mut input = vec![0.0; frames];
         input[0] = -0.01;

@@ -144,52 +144,20 @@ fn is_zero(e: &Expr) -> bool {
 }
 
 fn law_args(law: &Law) -> (&'static str, Vec<&Expr>) {
-    // Trailing optional arguments equal to 0 are left out (they default to 0, §2.9).
     match law {
         Law::Spring { k } => ("spring", vec![k]),
         Law::Damper { z } => ("damper", vec![z]),
-        Law::SpringDamper { k, z } => ("springDamper", vec![k, z]),
-        Law::Contact { k, z, thresh } => (
-            "contact",
-            if is_zero(thresh) {
-                vec![k, z]
-            } else {
-                vec![k, z, thresh]
-            },
-        ),
-        Law::NlContact {
-            k,
-            q,
-            klim,
-            z,
-            thresh,
-        } => (
-            "nlContact",
-            if is_zero(thresh) {
-                vec![k, q, klim, z]
-            } else {
-                vec![k, q, klim, z, thresh]
-            },
-        ),
-        Law::NlSpring2 { k, q, z } => ("nlSpring2", vec![k, q, z]),
-        Law::NlSpring3 { k, q, z } => ("nlSpring3", vec![k, q, z]),
-        Law::NlSpringDamper { k, q, klim, z } => ("nlSpringDamper", vec![k, q, klim, z]),
-        Law::NlPluck { k, scale, z } => (
-            "nlPluck",
-            if is_zero(z) {
-                vec![k, scale]
-            } else {
-                vec![k, scale, z]
-            },
-        ),
-        Law::NlBow { z, scale, smooth } => (
-            "nlBow",
-            if is_zero(smooth) {
-                vec![z, scale]
-            } else {
-                vec![z, scale, smooth]
-            },
-        ),
+        _ => {
+            // The kind's columns; trailing optional ones equal to 0 are left out (they default
+            // to 0, §2.9).
+            static ZERO: Expr = Expr::Num(0.0);
+            let row = law.kind().row();
+            let mut args: Vec<&Expr> = law.columns(&ZERO)[..row.columns.len()].to_vec();
+            while args.len() > row.required && args.last().is_some_and(|e| is_zero(e)) {
+                args.pop();
+            }
+            (row.keyword, args)
+        }
     }
 }
 

@@ -2,7 +2,7 @@
 //! (spec §6.4) and the legacy proxy forms (spec §3.14), then the element or parameter it
 //! declares, in the open buffer scopes.
 
-use super::keywords::{arity, shape_of, Shape, KEYWORDS};
+use super::keywords::{arity, keywords, shape_of, Shape};
 use super::lines::Item;
 use super::{At, Builder};
 use crate::lang::diagnostics::DiagnosticCode;
@@ -58,10 +58,7 @@ impl Builder<'_> {
                 kw.col,
                 format!("unknown type keyword `{}`", kw.source()),
             );
-            if let Some((k, _)) = KEYWORDS
-                .iter()
-                .find(|(k, _)| k.eq_ignore_ascii_case(&keyword))
-            {
+            if let Some((k, _)) = keywords().find(|(k, _)| k.eq_ignore_ascii_case(&keyword)) {
                 d.message.push_str(&format!(" (did you mean `{k}`?)"));
                 d = d.with_expected(format!("`{k}`"));
             }

@@ -1,12 +1,13 @@
 //! Each element kind's arguments (spec §2.9): masses, interactions and their laws, macros,
 //! inputs and outputs.
 
-use super::keywords::{LawKind, Shape};
+use super::keywords::{LawForm, Shape};
 use super::{At, Builder, MAX_MACRO_NODES};
 use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::legacy;
 use crate::lang::lexer::Token;
+use crate::laws::LawKind;
 use crate::spec::{ElementKind, Law, MacroKind, MacroSpec};
 
 impl Builder<'_> {
@@ -78,11 +79,11 @@ impl Builder<'_> {
                     delayed: delayed?,
                 })
             }
-            Shape::Law(kind) => {
+            Shape::Law(form) => {
                 let a = self.slot_endpoint(args, 0, points, at);
                 let b = self.slot_endpoint(args, 1, points, at);
                 // Optional trailing arguments default to 0 (spec §2.9).
-                let mut p: [Expr; MAX_LAW_PARAMS] = std::array::from_fn(|_| Expr::Num(0.0));
+                let mut p: [Expr; LawKind::MAX_ARITY] = std::array::from_fn(|_| Expr::Num(0.0));
                 let mut params_ok = true;
                 for (slot, t) in p.iter_mut().zip(args.get(2..).unwrap_or(&[])) {
                     match self.expr(t, at) {
@@ -94,7 +95,7 @@ impl Builder<'_> {
                 if !params_ok {
                     return None;
                 }
-                let law = make_law(kind, n - 2, p)?;
+                let law = make_law(form, n - 2, p);
                 Some(ElementKind::Interaction { law, a, b })
             }
             Shape::Macro(kind) => {
@@ -183,63 +184,20 @@ impl Builder<'_> {
     }
 }
 
-/// The most parameters a law takes (`nlContact`: K, KnlQ, Klim, Z, thresh).
-const MAX_LAW_PARAMS: usize = 5;
-
 /// Builds a law from its parameters (0 for the optional ones not written, and in the slots past
 /// the law's own); `given` is the number written, which selects the legacy two-parameter
 /// `spring` (= springDamper, spec §3.12 a).
-fn make_law(kind: LawKind, given: usize, p: [Expr; MAX_LAW_PARAMS]) -> Option<Law> {
-    let mut it = p.into_iter();
-    let mut next = || it.next();
-    Some(match kind {
-        LawKind::Spring if given == 2 => Law::SpringDamper {
-            k: next()?,
-            z: next()?,
-        },
-        LawKind::Spring => Law::Spring { k: next()? },
-        LawKind::Damper => Law::Damper { z: next()? },
-        LawKind::SpringDamper => Law::SpringDamper {
-            k: next()?,
-            z: next()?,
-        },
-        LawKind::Contact => Law::Contact {
-            k: next()?,
-            z: next()?,
-            thresh: next()?,
-        },
-        LawKind::NlContact => Law::NlContact {
-            k: next()?,
-            q: next()?,
-            klim: next()?,
-            z: next()?,
-            thresh: next()?,
-        },
-        LawKind::NlSpring2 => Law::NlSpring2 {
-            k: next()?,
-            q: next()?,
-            z: next()?,
-        },
-        LawKind::NlSpring3 => Law::NlSpring3 {
-            k: next()?,
-            q: next()?,
-            z: next()?,
-        },
-        LawKind::NlSpringDamper => Law::NlSpringDamper {
-            k: next()?,
-            q: next()?,
-            klim: next()?,
-            z: next()?,
-        },
-        LawKind::NlPluck => Law::NlPluck {
-            k: next()?,
-            scale: next()?,
-            z: next()?,
-        },
-        LawKind::NlBow => Law::NlBow {
-            z: next()?,
-            scale: next()?,
-            smooth: next()?,
-        },
-    })
+fn make_law(form: LawForm, given: usize, p: [Expr; LawKind::MAX_ARITY]) -> Law {
+    match form {
+        LawForm::Spring if given == 2 => Law::from_columns(LawKind::SpringDamper, p),
+        LawForm::Spring => {
+            let [k, ..] = p;
+            Law::Spring { k }
+        }
+        LawForm::Damper => {
+            let [z, ..] = p;
+            Law::Damper { z }
+        }
+        LawForm::Full(kind) => Law::from_columns(kind, p),
+    }
 }

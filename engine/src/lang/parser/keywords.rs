@@ -2,21 +2,19 @@
 //! each selects, and the accepted argument counts.
 
 use crate::lang::symbols::SymKind;
+use crate::laws::LawKind;
 use crate::spec::MacroKind;
 
-/// The interaction laws, before their arguments are known.
+/// How a script writes an interaction (spec §2.9): a law under its own keyword, every column
+/// in order ([`LawKind::row`]), or one of the short forms of the spring-damper.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum LawKind {
+pub(super) enum LawForm {
+    /// The law's own keyword (or an alias of it).
+    Full(LawKind),
+    /// `spring m1 m2 K`, and the legacy `spring m1 m2 K Z` (spec §3.12 a).
     Spring,
+    /// `damper m1 m2 Z`.
     Damper,
-    SpringDamper,
-    Contact,
-    NlContact,
-    NlSpring2,
-    NlSpring3,
-    NlSpringDamper,
-    NlPluck,
-    NlBow,
 }
 
 /// The argument shape a type keyword selects (spec §3.4, §2.9).
@@ -26,7 +24,7 @@ pub(super) enum Shape {
     Osc,
     Ground,
     MassG,
-    Law(LawKind),
+    Law(LawForm),
     Macro(MacroKind),
     PosInput,
     FrcInput,
@@ -36,23 +34,16 @@ pub(super) enum Shape {
     AudioParam,
 }
 
-/// Every type keyword of spec §2.9, with the legacy aliases of §3.12 a.
-pub(super) const KEYWORDS: [(&str, Shape); 27] = [
+/// The type keywords of spec §2.9 besides the laws' own ([`keywords`] adds those), with the
+/// legacy aliases of §3.12 a.
+const OTHER_KEYWORDS: [(&str, Shape); 19] = [
     ("mass", Shape::Mass),
     ("osc", Shape::Osc),
     ("ground", Shape::Ground),
     ("massG", Shape::MassG),
-    ("spring", Shape::Law(LawKind::Spring)),
-    ("damper", Shape::Law(LawKind::Damper)),
-    ("springDamper", Shape::Law(LawKind::SpringDamper)),
-    ("contact", Shape::Law(LawKind::Contact)),
-    ("nlContact", Shape::Law(LawKind::NlContact)),
-    ("nlSpring2", Shape::Law(LawKind::NlSpring2)),
-    ("nlSpring", Shape::Law(LawKind::NlSpring2)),
-    ("nlSpring3", Shape::Law(LawKind::NlSpring3)),
-    ("nlSpringDamper", Shape::Law(LawKind::NlSpringDamper)),
-    ("nlPluck", Shape::Law(LawKind::NlPluck)),
-    ("nlBow", Shape::Law(LawKind::NlBow)),
+    ("spring", Shape::Law(LawForm::Spring)),
+    ("damper", Shape::Law(LawForm::Damper)),
+    ("nlSpring", Shape::Law(LawForm::Full(LawKind::NlSpring2))),
     ("string", Shape::Macro(MacroKind::String)),
     ("chain", Shape::Macro(MacroKind::Chain)),
     ("stiffString", Shape::Macro(MacroKind::StiffString)),
@@ -67,31 +58,31 @@ pub(super) const KEYWORDS: [(&str, Shape); 27] = [
     ("audioParam", Shape::AudioParam),
 ];
 
+/// Every type keyword: each law's own, from the table of laws, then the others.
+pub(super) fn keywords() -> impl Iterator<Item = (&'static str, Shape)> {
+    LawKind::ALL
+        .into_iter()
+        .map(|k| (k.row().keyword, Shape::Law(LawForm::Full(k))))
+        .chain(OTHER_KEYWORDS)
+}
+
 pub(super) fn shape_of(keyword: &str) -> Option<Shape> {
-    KEYWORDS
-        .iter()
-        .find(|(k, _)| *k == keyword)
-        .map(|(_, s)| *s)
+    keywords().find(|(k, _)| *k == keyword).map(|(_, s)| s)
 }
 
 /// The accepted argument counts (after the keyword) and the signature for messages (§2.9).
 pub(super) fn arity(shape: Shape) -> (usize, usize, &'static str) {
-    use LawKind as L;
     match shape {
         Shape::Mass => (3, 4, "M {gravity} pos vel"),
         Shape::Osc => (5, 6, "M K Z {gravity} pos vel"),
         Shape::Ground => (1, 1, "pos"),
         Shape::MassG => (4, 4, "M G X0 XR0"),
-        Shape::Law(L::Spring) => (3, 4, "m1 m2 K {Z}"),
-        Shape::Law(L::Damper) => (3, 3, "m1 m2 Z"),
-        Shape::Law(L::SpringDamper) => (4, 4, "m1 m2 K Z"),
-        Shape::Law(L::Contact) => (4, 5, "m1 m2 K Z {thresh}"),
-        Shape::Law(L::NlContact) => (6, 7, "m1 m2 K KnlQ Klim Z {thresh}"),
-        Shape::Law(L::NlSpring2) => (5, 5, "m1 m2 K KnlP Z"),
-        Shape::Law(L::NlSpring3) => (5, 5, "m1 m2 K KnlQ Z"),
-        Shape::Law(L::NlSpringDamper) => (6, 6, "m1 m2 K KnlQ Klim Z"),
-        Shape::Law(L::NlPluck) => (4, 5, "m1 m2 Knl Pscale {Z}"),
-        Shape::Law(L::NlBow) => (4, 5, "m1 m2 Znl Vscale {smooth}"),
+        Shape::Law(LawForm::Spring) => (3, 4, "m1 m2 K {Z}"),
+        Shape::Law(LawForm::Damper) => (3, 3, "m1 m2 Z"),
+        Shape::Law(LawForm::Full(kind)) => {
+            let row = kind.row();
+            (2 + row.required, 2 + row.columns.len(), row.signature)
+        }
         Shape::Macro(MacroKind::String | MacroKind::Chain) => (6, 7, "nbMass M K Z {Zo} pos vel"),
         Shape::Macro(MacroKind::StiffString) => (7, 8, "nbMass M K K2 Z {Zo} pos vel"),
         Shape::Macro(_) => (7, 8, "nbX nbY M K Z {Zo} pos vel"),

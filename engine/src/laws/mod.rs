@@ -4,6 +4,14 @@
 //! Δv = (x₁ − x̃₁) − (x₂ − x̃₂) (units per step, spec §1.3) and the per-step parameters, and
 //! returns the scalar force f. The caller applies F₁ −= f, F₂ += f. The kernels of
 //! [`crate::engine`] call these functions, so the code here is the one place the equations live.
+//!
+//! [`LawKind`] lists the laws, with each one's row of the table ([`table`]) and its slope for
+//! the analyses ([`linear`]).
+
+pub(crate) mod linear;
+mod table;
+
+pub use table::{Column, LawKind, LawRow};
 
 /// `spring`, `damper`, `springDamper` (spec §2.3): f = K·Δx + Z·Δv.
 #[inline(always)]
