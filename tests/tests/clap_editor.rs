@@ -28,13 +28,26 @@ fn the_editor_opens_in_a_clap_host_and_shows_sidechain_strikes() {
     let Ok(display) = std::env::var(DISPLAY_ENV) else {
         let x = Xvfb::start(1280, 800)
             .expect("Xvfb starts (scripts/setup.sh installs the xvfb package)");
-        let status = std::process::Command::new(std::env::current_exe().unwrap())
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
             .args([name, "--exact", "--nocapture", "--test-threads=1"])
             .env(DISPLAY_ENV, x.display())
             .env("DISPLAY", x.display())
-            .status()
+            .output()
             .expect("run the test in a child process");
-        assert!(status.success(), "the editor test failed: {status}");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        print!("{stdout}");
+        eprint!("{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "the editor test failed: {}",
+            out.status
+        );
+        // The child ran this very test: a renamed test would otherwise match nothing and pass.
+        assert!(
+            stdout.contains(&format!("test {name} ... "))
+                && stdout.contains("test result: ok. 1 passed"),
+            "the child process did not run `{name}`"
+        );
         return;
     };
     let host = HostWindow::open(&display, "Test DAW", 1100, 700).expect("host window");

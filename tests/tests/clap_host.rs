@@ -627,9 +627,10 @@ fn force_inputs_and_strikes_sound_the_same_at_every_sample_rate() {
         spread.extend(ratios.iter().map(|r| (r - 1.0).abs()));
     }
     let worst = spread.iter().cloned().fold(0.0, f64::max);
+    // The README's figure: within 0.4 % (the sidechain push at 96 kHz measures 0.32 %).
     assert!(
-        worst < 0.02,
-        "the response to the same force moves by {:.1} % across sample rates",
+        worst < 0.004,
+        "the response to the same force moves by {:.2} % across sample rates",
         worst * 100.0
     );
 }

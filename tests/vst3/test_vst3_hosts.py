@@ -168,7 +168,8 @@ def test_pedalboard_plays_a_chord_as_the_sum_of_its_notes(preset_dir):
     error = np.abs(chord - total).max()
     print(f"chord peak {level:.4f}, largest difference from the sum {error:.2e}")
     assert 1e-3 < level < 0.5
-    assert error <= 1e-5 * level
+    # The README's bar for a chord (10⁻⁶ of its peak, as in the CLAP test host).
+    assert error <= 1e-6 * level
 
 
 def test_pedalboard_hears_a_voices_change_without_reactivating(preset_dir):
