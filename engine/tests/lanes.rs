@@ -3,14 +3,9 @@
 
 mod common;
 
-use common::engine;
+use common::{engine, spec};
 use ressort_engine::lanes::{LaneEngine, LANES};
-use ressort_engine::{parse, Engine, ModelSpec, ScaleClass};
-
-fn spec(text: &str) -> ModelSpec {
-    let parsed = parse(text);
-    parsed.spec.expect("a spec")
-}
+use ressort_engine::{Engine, ModelSpec, ScaleClass};
 
 /// A gallery model as published, as the presets of `models/` stood before the instrument's
 /// exciters: the Oscillator tutorials' bow and plectrum forces as literals (the presets press

@@ -1,6 +1,8 @@
 //! The example scripts of spec §7 parse without errors, compile to the counts the spec states,
 //! match the Rust reference models, and survive `parse(print(parse(x))) == parse(x)`.
 
+mod common;
+
 use ressort_engine::lang::{parse, print};
 use ressort_engine::{
     compile, reference, CompileOptions, ElementKind, Endpoint, Expr, Law, ModelSpec,
@@ -147,13 +149,6 @@ const GALLERY_FRAGMENTS: &str = "@bowPos audioParam @in2
 @out2 frcOutput [@me1 0.7 0.7]
 ";
 
-fn parse_ok(name: &str, text: &str) -> ModelSpec {
-    let parsed = parse(text);
-    let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
-    assert!(errors.is_empty(), "{name}: {errors:#?}");
-    parsed.spec.expect("no errors, so a spec")
-}
-
 fn counts(spec: &ModelSpec) -> (usize, usize) {
     let engine = compile(spec, &CompileOptions::default())
         .unwrap_or_else(|e| panic!("compile failed:\n{e}"));
@@ -201,30 +196,30 @@ fn every_example_has_no_diagnostics_and_round_trips() {
 #[test]
 fn canonical_definitions_have_the_stated_counts() {
     // Spec §7.10: 1004/1003, 227/422, 502/957.
-    assert_eq!(counts(&parse_ok("string", STRING_1000)), (1004, 1003));
-    assert_eq!(counts(&parse_ok("mesh15", MESH_15X15)), (227, 422));
-    assert_eq!(counts(&parse_ok("mesh25", MESH_25X20)), (502, 957));
+    assert_eq!(counts(&common::spec(STRING_1000)), (1004, 1003));
+    assert_eq!(counts(&common::spec(MESH_15X15)), (227, 422));
+    assert_eq!(counts(&common::spec(MESH_25X20)), (502, 957));
 }
 
 #[test]
 fn tutorial_scripts_have_their_counts() {
     // hammerOscillator: o, ham, g / sp, c.
-    assert_eq!(counts(&parse_ok("hammer", HAMMER_OSCILLATOR)), (3, 2));
+    assert_eq!(counts(&common::spec(HAMMER_OSCILLATOR)), (3, 2));
     // pluckedString: 40 nodes + avatar / 39 internal + pluck.
-    assert_eq!(counts(&parse_ok("plucked", PLUCKED_STRING)), (41, 40));
+    assert_eq!(counts(&common::spec(PLUCKED_STRING)), (41, 40));
     // motionRouting: 4 + 10 nodes / 4 + 9 internal + link.
-    assert_eq!(counts(&parse_ok("routing", MOTION_ROUTING)), (14, 14));
-    let gallery = parse_ok("gallery", GALLERY_FRAGMENTS);
+    assert_eq!(counts(&common::spec(MOTION_ROUTING)), (14, 14));
+    let gallery = common::spec(GALLERY_FRAGMENTS);
     compile(&gallery, &CompileOptions::default()).unwrap_or_else(|e| panic!("{e}"));
 }
 
 #[test]
 fn canonical_scripts_equal_the_reference_builders() {
-    assert_eq!(parse_ok("string", STRING_1000), reference::string_1000());
-    assert_eq!(parse_ok("mesh15", MESH_15X15), reference::mesh_15x15());
-    assert_eq!(parse_ok("mesh25", MESH_25X20), reference::mesh_25x20());
+    assert_eq!(common::spec(STRING_1000), reference::string_1000());
+    assert_eq!(common::spec(MESH_15X15), reference::mesh_15x15());
+    assert_eq!(common::spec(MESH_25X20), reference::mesh_25x20());
     assert_eq!(
-        parse_ok("hammer", HAMMER_OSCILLATOR),
+        common::spec(HAMMER_OSCILLATOR),
         reference::hammer_oscillator()
     );
 }
@@ -245,7 +240,7 @@ fn reference_models_print_and_parse_back() {
 
 #[test]
 fn motion_routing_scopes() {
-    let spec = parse_ok("routing", MOTION_ROUTING);
+    let spec = common::spec(MOTION_ROUTING);
     assert_eq!(spec.buffers, ["triangle", "string"]);
     let buffers = |l: &str| spec.element(l).unwrap().buffers.clone();
     for l in ["g", "m1", "m2", "m3", "s1", "s4"] {
@@ -261,7 +256,7 @@ fn motion_routing_scopes() {
 
 #[test]
 fn values_and_shapes() {
-    let spec = parse_ok("plucked", PLUCKED_STRING);
+    let spec = common::spec(PLUCKED_STRING);
     let Some(ElementKind::Interaction { law, a, b }) = spec.element("pl").map(|e| &e.kind) else {
         panic!("pl is an interaction");
     };
@@ -276,7 +271,7 @@ fn values_and_shapes() {
     assert_eq!(*a, Endpoint::at("s", "excPos"));
     assert_eq!(*b, Endpoint::label("in1"));
 
-    let g = parse_ok("gallery", GALLERY_FRAGMENTS);
+    let g = common::spec(GALLERY_FRAGMENTS);
     let kind = |l: &str| g.element(l).unwrap().kind.clone();
     assert!(matches!(
         kind("ls"),

@@ -5,22 +5,11 @@
 
 mod common;
 
-use common::{engine, impulse, render};
+use common::{clean_spec, engine, impulse, render};
 use ressort_engine::generators::{generate, Fixed, Generator, LatticeFixed, Topology};
 use ressort_engine::lang::{parse, print};
 use ressort_engine::{ElementKind, Endpoint, Expr, Law, ModelBuilder, ModelSpec, Vector};
 use std::collections::{HashMap, HashSet};
-
-#[track_caller]
-fn parse_ok(text: &str) -> ModelSpec {
-    let parsed = parse(text);
-    assert!(
-        parsed.diagnostics.is_empty(),
-        "{text}\n{:#?}",
-        parsed.diagnostics
-    );
-    parsed.spec.unwrap()
-}
 
 /// The generated structure as found in a parsed spec: nodes (with fixedness and position) and
 /// links (node index pairs, and whether the link is an undamped `Ks` stiffness link).
@@ -170,7 +159,7 @@ fn check(
     links: usize,
     fixed: usize,
 ) -> Graph {
-    let spec = parse_ok(directive);
+    let spec = clean_spec(directive);
     let mut b = ModelBuilder::new();
     let out = generate(&mut b, &generator, &topology).unwrap();
     assert_eq!(spec, b.build(), "{directive}: differs from the Rust API");
@@ -691,8 +680,8 @@ fn generated_string_equals_the_string_macro() {
     for (generated, macro_text) in cases {
         for sr in [44_100.0, 96_000.0] {
             let input = [impulse(0.01, 4000)];
-            let a = render(&mut engine(&parse_ok(generated), sr), 4000, 64, &input);
-            let m = render(&mut engine(&parse_ok(macro_text), sr), 4000, 64, &input);
+            let a = render(&mut engine(&clean_spec(generated), sr), 4000, 64, &input);
+            let m = render(&mut engine(&clean_spec(macro_text), sr), 4000, 64, &input);
             for (ch, (x, y)) in a.iter().zip(&m).enumerate() {
                 let peak = x.iter().fold(0.0f64, |p, v| p.max(v.abs()));
                 assert!(peak > 1e-6, "{generated}: channel {ch} silent");
@@ -731,7 +720,7 @@ fn generated_nodes_are_addressable() {
 ~generate chain late nodes=3 M=1 K=0.1 Z=0
 @l springDamper @late_m2 @str_g1 0.01 0
 ";
-    let spec = parse_ok(text);
+    let spec = clean_spec(text);
     // Values are evaluated once, from parameters declared above.
     let value = |n: &str| match spec.param(n).unwrap().kind {
         ressort_engine::ParamKind::Control { value } => value,
@@ -799,7 +788,7 @@ fn printed_generators_round_trip() {
 ~generate polyline p points=0,0;1,0.5;2,-1 closed=off M=1 K=0.1 Z=0
 @c springDamper @h_m2_0 @r_m4 0.1 0
 ";
-    let spec = parse_ok(text);
+    let spec = clean_spec(text);
     let printed = print(&spec);
     assert!(printed.contains("@h_M param 1.25\n"), "{printed}");
     assert!(

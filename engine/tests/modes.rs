@@ -3,17 +3,10 @@
 
 mod common;
 
-use common::{engine, impulse, render};
+use common::{engine, impulse, render, spec};
 use ressort_engine::modes::{note_frequency, note_name, Solver, StiffnessLimit};
-use ressort_engine::{parse, Engine, ModelSpec, ScaleClass};
+use ressort_engine::{Engine, ModelSpec, ScaleClass};
 use std::f64::consts::PI;
-
-fn spec(text: &str) -> ModelSpec {
-    let parsed = parse(text);
-    let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
-    assert!(errors.is_empty(), "{errors:?}");
-    parsed.spec.expect("a spec")
-}
 
 fn preset(name: &str) -> ModelSpec {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -2,7 +2,30 @@
 #![allow(dead_code)]
 
 use realfft::RealFftPlanner;
-use ressort_engine::{compile, CompileOptions, Engine, ModelSpec};
+use ressort_engine::{compile, parse, CompileOptions, Engine, ModelSpec};
+
+/// The spec of `text`, which must parse without errors (warnings allowed); else the test fails
+/// with the errors and the script's first line.
+#[track_caller]
+pub fn spec(text: &str) -> ModelSpec {
+    let parsed = parse(text);
+    let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
+    let first = text.lines().next().unwrap_or("");
+    assert!(errors.is_empty(), "{first}\n{errors:#?}");
+    parsed.spec.expect("no errors, so a spec")
+}
+
+/// As [`spec`], for a script that must parse without warnings either.
+#[track_caller]
+pub fn clean_spec(text: &str) -> ModelSpec {
+    let parsed = parse(text);
+    assert!(
+        parsed.diagnostics.is_empty(),
+        "{text}\n{:#?}",
+        parsed.diagnostics
+    );
+    parsed.spec.expect("no diagnostics, so a spec")
+}
 
 /// Compiles `spec` at `sr` or fails the test with the compile errors.
 pub fn engine(spec: &ModelSpec, sr: f64) -> Engine {
