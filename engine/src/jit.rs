@@ -230,8 +230,14 @@ impl Engine {
         let Some(entry) = self.native.as_ref().map(|code| code.entry) else {
             return 0;
         };
-        debug_assert!(inputs.len() >= in_channels * frames);
-        debug_assert!(outputs.len() >= out_channels * frames && samples.end <= frames);
+        // The native code reads and writes these buffers by raw pointer: checked on every call
+        // (two comparisons a block), in release builds too.
+        assert!(
+            inputs.len() >= in_channels.saturating_mul(frames)
+                && outputs.len() >= out_channels.saturating_mul(frames)
+                && samples.end <= frames,
+            "native code: buffers smaller than the block"
+        );
         let mut sink = [0.0f64; SPARE];
         let mut n = samples.start;
         while n < samples.end {
