@@ -314,32 +314,6 @@ impl Law {
             _ => self.kind().row().keyword,
         }
     }
-
-    /// The arguments with their scaling class, in script order.
-    pub fn args(&self) -> Vec<(&Expr, ScaleClass)> {
-        use ScaleClass::{Damping as Zc, None as N, Stiffness as Kc};
-        match self {
-            Law::Spring { k } => vec![(k, Kc)],
-            Law::Damper { z } => vec![(z, Zc)],
-            Law::SpringDamper { k, z } => vec![(k, Kc), (z, Zc)],
-            Law::Contact { k, z, thresh } => vec![(k, Kc), (z, Zc), (thresh, N)],
-            Law::NlContact {
-                k,
-                q,
-                klim,
-                z,
-                thresh,
-            } => vec![(k, Kc), (q, Kc), (klim, Kc), (z, Zc), (thresh, N)],
-            Law::NlSpring2 { k, q, z } | Law::NlSpring3 { k, q, z } => {
-                vec![(k, Kc), (q, Kc), (z, Zc)]
-            }
-            Law::NlSpringDamper { k, q, klim, z } => {
-                vec![(k, Kc), (q, Kc), (klim, Kc), (z, Zc)]
-            }
-            Law::NlPluck { k, scale, z } => vec![(k, Kc), (scale, N), (z, Zc)],
-            Law::NlBow { z, scale, smooth } => vec![(z, Zc), (scale, Zc), (smooth, N)],
-        }
-    }
 }
 
 /// The parameter scaling classes of spec §1.7.

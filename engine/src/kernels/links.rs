@@ -507,22 +507,6 @@ pub(crate) struct Interactions {
     pub groups: [Group; LawKind::COUNT],
 }
 
-/// The scalar kernel of each law, as [`Interactions::step`] and the voice lanes' stage 4 call
-/// it: this exhaustive match is the checklist for a new law.
-#[allow(dead_code)]
-const fn kernel_of(kind: LawKind) -> &'static str {
-    match kind {
-        LawKind::SpringDamper => "laws::spring_damper",
-        LawKind::Contact => "laws::contact",
-        LawKind::NlContact => "laws::nl_contact",
-        LawKind::NlSpring2 => "laws::nl_spring2",
-        LawKind::NlSpring3 => "laws::nl_spring3",
-        LawKind::NlSpringDamper => "laws::nl_spring_damper",
-        LawKind::Pluck => "laws::nl_pluck",
-        LawKind::Bow => "laws::nl_bow",
-    }
-}
-
 impl Interactions {
     /// The links of one law.
     #[inline(always)]
@@ -596,9 +580,8 @@ impl Interactions {
     #[inline(always)]
     pub(crate) fn step(&self, p: &mut Points, args: &[f64]) {
         // Written out law by law: a loop over `LawKind::ALL` with a `match` inside measured
-        // 30 % slower on the 100-mass string. `kernel_of` below fails to compile when a law is
-        // added without naming its kernel here; a law left out of this function would also
-        // differ from the native code, which walks `ALL` (the differential tests).
+        // 30 % slower on the 100-mass string. A law left out here differs from the native
+        // code, which walks `ALL` (the differential tests).
         let g = self.group(LawKind::SpringDamper);
         if g.len() > 0 {
             let (k, z) = (g.col(args, 0), g.col(args, 1));
