@@ -15,7 +15,7 @@
 //! engine's arrays at entry, so parameter and gain changes need no new code.
 //!
 //! The code does the interpreter's IEEE operations in the interpreter's order (no FMA, no
-//! reassociation; the laws in `jit/laws.rs`), so both give the same samples, bit for bit
+//! reassociation; the laws of `crate::laws` on `jit/arith.rs`), so both give the same samples, bit for bit
 //! (tests `native_code_equals_the_interpreter` and `every_law_equals_the_scalar_law`). The one
 //! choice fixed in the code is which single masses run the plain update (2X − X̃) + F·(1/M):
 //! the ones that were plain when the code was made. Plain is the general update's arithmetic
@@ -46,8 +46,8 @@ use cranelift_codegen::settings::{self, Configurable};
 use cranelift_jit::JITModule;
 use std::sync::{Mutex, OnceLock};
 
+pub(crate) mod arith;
 mod emit;
-pub(crate) mod laws;
 mod sample;
 
 /// The most points plus interactions a model compiled to native code may have. Beyond that

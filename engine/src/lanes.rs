@@ -13,19 +13,18 @@
 //! audio-rate parameters, and models of more than [`MAX_LANE_POINTS`] points, are not laned
 //! ([`LaneEngine::supports`]); they keep one [`Engine`] per voice.
 
-use crate::engine::{single_law, ArgClass, Group, Proxies, NUM_ARG_CLASSES};
+use crate::engine::{single_law, ArgClass, Proxies, NUM_ARG_CLASSES};
 use crate::engine::{FLUSH_BELOW, FLUSH_INTERVAL};
-use crate::laws::{self, LawKind};
+use crate::laws::LawKind;
 use crate::spec::ScaleClass;
 use crate::{Engine, ParamError, ParamId};
 
+mod arith;
 mod links;
 mod structures;
 mod vector;
-mod vector_laws;
 
-use links::{apply, Linear, PerLane};
-use links::{Contact, NlContact, NlSpring2, NlSpring3, NlSpringDamper, Pluck};
+use links::Stage4;
 use vector::Ops;
 
 /// Voices per lane group.
@@ -551,50 +550,14 @@ impl LaneEngine {
         let it = &self.template.interactions;
         let args = &self.args[..];
         let (x, xp, f) = (&self.x[..], &self.xp[..], &mut self.f[..]);
-        // A group's argument column c, sliced to the group's length.
-        let col = |g: &Group, c: usize| &args[g.cols[c]..g.cols[c] + g.len()];
-        // Law by law, as `Interactions::step` (a loop over the kinds measured slower there).
-        let g = it.group(LawKind::SpringDamper);
-        if g.len() > 0 {
-            let (k, z) = (col(g, 0), col(g, 1));
-            apply(o, g, x, xp, f, &Linear { k, z });
-        }
-        let g = it.group(LawKind::Contact);
-        if g.len() > 0 {
-            let (k, z, t) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(o, g, x, xp, f, &Contact { k, z, t });
-        }
-        let g = it.group(LawKind::NlContact);
-        if g.len() > 0 {
-            let (s, c, k, z, t) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3), col(g, 4));
-            apply(o, g, x, xp, f, &NlContact { s, c, k, z, t });
-        }
-        let g = it.group(LawKind::NlSpring2);
-        if g.len() > 0 {
-            let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(o, g, x, xp, f, &NlSpring2 { k, q, z });
-        }
-        let g = it.group(LawKind::NlSpring3);
-        if g.len() > 0 {
-            let (k, q, z) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(o, g, x, xp, f, &NlSpring3 { k, q, z });
-        }
-        let g = it.group(LawKind::NlSpringDamper);
-        if g.len() > 0 {
-            let (s, c, k, z) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3));
-            apply(o, g, x, xp, f, &NlSpringDamper { s, c, k, z });
-        }
-        let g = it.group(LawKind::Pluck);
-        if g.len() > 0 {
-            let (k, scale, z) = (col(g, 0), col(g, 1), col(g, 2));
-            apply(o, g, x, xp, f, &Pluck { k, scale, z });
-        }
-        let g = it.group(LawKind::Bow);
-        if g.len() > 0 {
-            let (z, sc, sm) = (col(g, 0), col(g, 1), col(g, 2));
-            let law = |i: usize, l: usize, _dx, dv| laws::nl_bow(dv, z[i][l], sc[i][l], sm[i][l]);
-            apply(o, g, x, xp, f, &PerLane(law));
-        }
+        LawKind::visit_all(&mut Stage4 {
+            o,
+            interactions: it,
+            args,
+            x,
+            xp,
+            f,
+        });
         for r in &self.template.force_inputs {
             // A silent or missing channel adds 0, as the plain engine does (−0 + 0 = +0).
             let fi = &mut f[r.index as usize];

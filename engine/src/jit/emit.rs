@@ -14,15 +14,13 @@
 //! due), so a channel the block does not have reads `Frame::zero` or writes `Frame::sink`,
 //! each that long, and every channel is addressed as base + 8·j.
 
-use super::laws::{self, Callees};
+use super::arith::Callees;
 use super::{Frame, NativeCode, BAIL, MAX_ELEMENTS};
 use crate::engine::{Engine, FLUSH_INTERVAL};
 use crate::kernels::links::Group;
 use crate::laws::LawKind;
 use cranelift_codegen::ir::condcodes::IntCC;
-use cranelift_codegen::ir::{
-    types, AbiParam, Block, InstBuilder, MemFlags, Signature, UserFuncName, Value,
-};
+use cranelift_codegen::ir::{types, AbiParam, Block, InstBuilder, MemFlags, UserFuncName, Value};
 use cranelift_codegen::Context;
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext, Variable};
 use cranelift_jit::{JITBuilder, JITModule};
@@ -101,13 +99,7 @@ pub(super) fn compile(engine: &Engine) -> Option<NativeCode> {
     let mut fctx = FunctionBuilderContext::new();
     let masses = {
         let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
-        let mut exp_sig = Signature::new(call_conv);
-        exp_sig.params.push(AbiParam::new(types::F64));
-        exp_sig.returns.push(AbiParam::new(types::F64));
-        let callees = Callees {
-            exp_sig: b.import_signature(exp_sig),
-            exp_addr: laws::exp as *const () as usize as i64,
-        };
+        let callees = Callees::import(&mut b, call_conv);
         let masses = Emitter::new(engine, &mut b, callees).function();
         b.seal_all_blocks();
         b.finalize();

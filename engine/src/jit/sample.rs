@@ -14,8 +14,8 @@
 //! ground) are tested before the sample changes anything; they leave it for its bail-out
 //! block, which stores the state, and the driver runs that sample on the interpreter.
 
+use super::arith;
 use super::emit::{Emitter, Setup, FLAGS};
-use super::laws;
 use super::BAIL;
 use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
 use cranelift_codegen::ir::{types, Block, InstBuilder, MemFlags, Value};
@@ -166,7 +166,7 @@ impl Emitter<'_, '_> {
                 let args: Vec<Value> = (0..law.arity())
                     .map(|c| self.load(setup.args, g.cols[c] + i))
                     .collect();
-                let force = laws::emit(self.b, law, dx, dv, &args, self.callees);
+                let force = arith::emit(self.b, law, dx, dv, &args, self.callees);
                 self.link_forces(pa, pb, force, setup.sign, &mut touched);
             }
         }

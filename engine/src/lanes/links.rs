@@ -2,16 +2,13 @@
 //! its own arguments, in the plain engine's order (`Group::apply`), so that each lane equals
 //! a plain engine bit for bit (engine test `lanes`).
 
+use super::arith::TableLaw;
 use super::vector::{self, Ops};
-use super::vector_laws;
 use super::Lanes;
 use crate::engine::Group;
-
-/// A nonlinear law computed lane by lane (`law(l)` for each lane `l`).
-#[inline(always)]
-pub(super) fn per_lane(law: impl Fn(usize) -> f64) -> Lanes {
-    Lanes(std::array::from_fn(law))
-}
+use crate::engine::Interactions;
+use crate::laws::{Law, LawKind, LawVisitor};
+use std::marker::PhantomData;
 
 /// A link law in every lane: the force of a group's link `i` from the deltas of every lane.
 /// A trait with inlined methods rather than a closure: a closure is compiled without the
@@ -24,85 +21,6 @@ pub(super) trait LaneLaw {
     fn args(&self, i: usize) -> Self::Args;
     /// The force for `args` and the deltas of every lane.
     fn force<S: pulp::Simd>(&self, o: Ops<S>, args: Self::Args, dx: Lanes, dv: Lanes) -> Lanes;
-}
-
-/// `spring`, `damper`, `springDamper`: f = K·Δx + Z·Δv, in vectors (`laws::spring_damper`).
-pub(super) struct Linear<'a> {
-    pub k: &'a [Lanes],
-    pub z: &'a [Lanes],
-}
-
-impl LaneLaw for Linear<'_> {
-    type Args = (Lanes, Lanes);
-    #[inline(always)]
-    fn args(&self, i: usize) -> (Lanes, Lanes) {
-        (self.k[i], self.z[i])
-    }
-    #[inline(always)]
-    fn force<S: pulp::Simd>(
-        &self,
-        o: Ops<S>,
-        (k, z): (Lanes, Lanes),
-        dx: Lanes,
-        dv: Lanes,
-    ) -> Lanes {
-        vector::spring_damper(o, dx, dv, k, z)
-    }
-}
-
-/// Link laws in vectors (`vector_laws`): a struct of the group's argument columns per law.
-macro_rules! vector_links {
-    ($($(#[$doc:meta])* $name:ident => $law:ident($($arg:ident),*);)*) => {$(
-        $(#[$doc])*
-        pub(super) struct $name<'a> {
-            $(pub $arg: &'a [Lanes],)*
-        }
-
-        impl LaneLaw for $name<'_> {
-            type Args = ($(vector_links!(@lanes $arg),)*);
-            #[inline(always)]
-            fn args(&self, i: usize) -> Self::Args {
-                ($(self.$arg[i],)*)
-            }
-            #[inline(always)]
-            fn force<S: pulp::Simd>(&self, o: Ops<S>, args: Self::Args, dx: Lanes, dv: Lanes) -> Lanes {
-                let ($($arg,)*) = args;
-                vector_laws::$law(o, dx, dv $(, $arg)*)
-            }
-        }
-    )*};
-    (@lanes $arg:ident) => { Lanes };
-}
-
-vector_links! {
-    /// `contact` (spec §2.4.1).
-    Contact => contact(k, z, t);
-    /// `nlContact` (spec §2.4.2).
-    NlContact => nl_contact(s, c, k, z, t);
-    /// `nlSpring2` (spec §2.5.1).
-    NlSpring2 => nl_spring2(k, q, z);
-    /// `nlSpring3` (spec §2.5.2).
-    NlSpring3 => nl_spring3(k, q, z);
-    /// `nlSpringDamper` (spec §2.5.3).
-    NlSpringDamper => nl_spring_damper(s, c, k, z);
-    /// `nlPluck` (spec §2.6.1).
-    Pluck => nl_pluck(k, scale, z);
-}
-
-/// A nonlinear law, lane by lane: `law(i, lane, Δx, Δv)` (`nlBow`).
-pub(super) struct PerLane<F>(pub F);
-
-impl<F: Fn(usize, usize, f64, f64) -> f64> LaneLaw for PerLane<F> {
-    /// The link's index: the closure reads its arguments.
-    type Args = usize;
-    #[inline(always)]
-    fn args(&self, i: usize) -> usize {
-        i
-    }
-    #[inline(always)]
-    fn force<S: pulp::Simd>(&self, _o: Ops<S>, i: usize, dx: Lanes, dv: Lanes) -> Lanes {
-        per_lane(|l| (self.0)(i, l, dx[l], dv[l]))
-    }
 }
 
 /// `law` on every pair of a group and every lane, with the convention of spec §1.3: F₁ −= f,
@@ -215,5 +133,40 @@ fn band<S: pulp::Simd, L: LaneLaw>(
         let force = law.force(o, args(j), dx, dv);
         f[j] = o.sub(f[j], force);
         f[j + d] = o.add(f[j + d], force);
+    }
+}
+
+/// Stage 4 in lanes, law by law as `Interactions::step` runs it ([`LawKind::visit_all`]):
+/// each group with its argument columns (`args`, one [`Lanes`] per slot).
+pub(super) struct Stage4<'a, S> {
+    pub o: Ops<S>,
+    pub interactions: &'a Interactions,
+    pub args: &'a [Lanes],
+    pub x: &'a [Lanes],
+    pub xp: &'a [Lanes],
+    pub f: &'a mut [Lanes],
+}
+
+impl<S: pulp::Simd> LawVisitor for Stage4<'_, S> {
+    #[inline(always)]
+    fn visit<L: Law>(&mut self, kind: LawKind) {
+        let g = self.interactions.group(kind);
+        if g.len() == 0 {
+            return;
+        }
+        let arity = L::ROW.columns.len();
+        let args = self.args;
+        let cols = std::array::from_fn(|c| {
+            if c < arity {
+                &args[g.cols[c]..g.cols[c] + g.len()]
+            } else {
+                &[][..]
+            }
+        });
+        let law = TableLaw::<L> {
+            cols,
+            law: PhantomData,
+        };
+        apply(self.o, g, self.x, self.xp, self.f, &law);
     }
 }

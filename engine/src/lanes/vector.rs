@@ -14,6 +14,7 @@
 //! mesh in lanes ran 25 times slower that way).
 
 use super::Lanes;
+use crate::laws::LawKind;
 use pulp::Simd;
 
 /// The lane-wise operations of one instruction set `S`.
@@ -108,10 +109,19 @@ impl<S: Simd> Ops<S> {
     }
 }
 
-/// `spring`, `damper`, `springDamper` in every lane: f = K·Δx + Z·Δv (`laws::spring_damper`).
+/// `spring`, `damper`, `springDamper` in every lane: f = K·Δx + Z·Δv, the table's law on
+/// each native vector (the strings and meshes of `structures.rs`).
 #[inline(always)]
 pub(super) fn spring_damper<S: Simd>(o: Ops<S>, dx: Lanes, dv: Lanes, k: Lanes, z: Lanes) -> Lanes {
-    o.add(o.mul(k, dx), o.mul(z, dv))
+    let a = super::arith::Native(o.0);
+    let mut out = Lanes::ZERO;
+    let (out_v, _) = S::as_mut_simd_f64s(&mut out.0);
+    let (dx, dv) = (S::as_simd_f64s(&dx.0).0, S::as_simd_f64s(&dv.0).0);
+    let (k, z) = (S::as_simd_f64s(&k.0).0, S::as_simd_f64s(&z.0).0);
+    for i in 0..out_v.len() {
+        out_v[i] = LawKind::SpringDamper.force(&a, dx[i], dv[i], &[k[i], z[i]]);
+    }
+    out
 }
 
 /// Δx = x_a − x_b and Δv = (x_a − x̃_a) − (x_b − x̃_b) in every lane (spec §1.3).
