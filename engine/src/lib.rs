@@ -50,10 +50,11 @@ pub use engine::{
 pub use expr::{BinOp, Expr, Func};
 pub use info::{InputUse, ModelInfo, OutputUse, PointInfo, PointKind};
 pub use lang::{parse, parse_bytes, print, Diagnostic, DiagnosticCode, Parsed, Severity};
+pub use laws::LawKind;
 pub use motion::{MotionLayout, MotionStore, NamedBuffer};
 pub use spec::{
-    Element, ElementKind, Endpoint, ExciterDecl, ExciterKind, HostSpec, Label, Law, MacroKind,
-    MacroRange, MacroSpec, ModelBuilder, ModelSpec, ParamDecl, ParamKind, Route, RouteSource,
-    SampleRateMode, ScaleClass, Span, Vector, REFERENCE_SAMPLE_RATE_HZ,
+    Element, ElementKind, Endpoint, ExciterDecl, ExciterKind, HostSpec, Label, Law, LawForm,
+    MacroKind, MacroRange, MacroSpec, ModelBuilder, ModelSpec, ParamDecl, ParamKind, Route,
+    RouteSource, SampleRateMode, ScaleClass, Span, Vector, REFERENCE_SAMPLE_RATE_HZ,
 };
 pub use stability::{MassStability, StabilityReport, StabilityWarning};

@@ -3,15 +3,12 @@
 //! 44.1 kHz" (scaled mode).
 
 use crate::expr::Expr;
+use crate::laws::LawKind;
 use crate::spec::{Endpoint, Law, MacroKind, MacroSpec, ModelBuilder, ModelSpec};
 
 /// A contact law with threshold 0.
 fn contact(k: impl Into<Expr>, z: impl Into<Expr>) -> Law {
-    Law::Contact {
-        k: k.into(),
-        z: z.into(),
-        thresh: Expr::Num(0.0),
-    }
+    Law::new(LawKind::Contact, [k.into(), z.into()])
 }
 
 /// The hammer block of the canonical definitions (spec §7.10): a hammer of M = 1 resting at

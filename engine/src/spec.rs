@@ -185,134 +185,133 @@ impl Endpoint {
     }
 }
 
-/// The law of an interaction (spec §2.3–§2.6), with its arguments in script order.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Law {
-    /// `spring m1 m2 K`: f = K·Δx.
-    Spring { k: Expr },
+/// How a script writes an interaction (spec §2.9): a law under its own keyword, every column
+/// in order ([`LawKind::row`]), or one of the short forms of the spring-damper.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LawForm {
+    /// The law's own keyword (or an alias of it).
+    Full(LawKind),
+    /// `spring m1 m2 K`: f = K·Δx (and the legacy `spring m1 m2 K Z`, spec §3.12 a, which is
+    /// read as `springDamper`).
+    Spring,
     /// `damper m1 m2 Z`: f = Z·Δv.
-    Damper { z: Expr },
-    /// `springDamper m1 m2 K Z`: f = K·Δx + Z·Δv.
-    SpringDamper { k: Expr, z: Expr },
-    /// `contact m1 m2 K Z {thresh=0}`.
-    Contact { k: Expr, z: Expr, thresh: Expr },
-    /// `nlContact m1 m2 K KnlQ Klim Z {thresh=0}`: (s, c, k, Z, θ).
-    NlContact {
-        k: Expr,
-        q: Expr,
-        klim: Expr,
-        z: Expr,
-        thresh: Expr,
-    },
-    /// `nlSpring2 m1 m2 K KnlP Z` (alias `nlSpring`).
-    NlSpring2 { k: Expr, q: Expr, z: Expr },
-    /// `nlSpring3 m1 m2 K KnlQ Z`.
-    NlSpring3 { k: Expr, q: Expr, z: Expr },
-    /// `nlSpringDamper m1 m2 K KnlQ Klim Z`: (s, c, k, Z).
-    NlSpringDamper {
-        k: Expr,
-        q: Expr,
-        klim: Expr,
-        z: Expr,
-    },
-    /// `nlPluck m1 m2 Knl Pscale {Z=0}`.
-    NlPluck { k: Expr, scale: Expr, z: Expr },
-    /// `nlBow m1 m2 Znl Vscale {smooth=0}`.
-    NlBow { z: Expr, scale: Expr, smooth: Expr },
+    Damper,
+}
+
+impl LawForm {
+    /// The law the form writes.
+    pub fn kind(self) -> LawKind {
+        match self {
+            LawForm::Full(kind) => kind,
+            LawForm::Spring | LawForm::Damper => LawKind::SpringDamper,
+        }
+    }
+
+    /// The kind's columns the form writes, in order: all of them for a law's own keyword,
+    /// K for `spring`, Z for `damper`.
+    pub fn columns(self) -> std::ops::Range<usize> {
+        match self {
+            LawForm::Full(kind) => 0..kind.arity(),
+            LawForm::Spring => 0..1,
+            LawForm::Damper => 1..2,
+        }
+    }
+
+    /// The keyword that writes the form.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            LawForm::Full(kind) => kind.row().keyword,
+            LawForm::Spring => "spring",
+            LawForm::Damper => "damper",
+        }
+    }
+}
+
+/// The law of an interaction (spec §2.3–§2.6): how it is written and its arguments, the
+/// columns of its kind's row ([`crate::laws::LawRow::columns`]) that the form writes, in
+/// order. Every law has this one shape, so a law added to the table needs nothing here.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Law {
+    form: LawForm,
+    args: Vec<Expr>,
 }
 
 impl Law {
+    /// The law `kind` under its own keyword with `args` as its columns in order; columns not
+    /// given are 0 (the default of an optional column, spec §2.9), extra ones are dropped.
+    pub fn new(kind: LawKind, args: impl IntoIterator<Item = Expr>) -> Law {
+        Law::of_form(LawForm::Full(kind), args)
+    }
+
+    /// The law written in `form`, with `args` as the columns it writes.
+    pub fn of_form(form: LawForm, args: impl IntoIterator<Item = Expr>) -> Law {
+        let n = form.columns().len();
+        let mut args: Vec<Expr> = args.into_iter().take(n).collect();
+        args.resize(n, Expr::Num(0.0));
+        Law { form, args }
+    }
+
+    /// `spring m1 m2 K`.
+    pub fn spring(k: Expr) -> Law {
+        Law::of_form(LawForm::Spring, [k])
+    }
+
+    /// `damper m1 m2 Z`.
+    pub fn damper(z: Expr) -> Law {
+        Law::of_form(LawForm::Damper, [z])
+    }
+
+    /// How the law is written.
+    pub fn form(&self) -> LawForm {
+        self.form
+    }
+
     /// The law's kind: its row of the table of laws ([`LawKind::row`]). `spring` and
     /// `damper` are spring-dampers with one column written.
     pub fn kind(&self) -> LawKind {
-        match self {
-            Law::Spring { .. } | Law::Damper { .. } | Law::SpringDamper { .. } => {
-                LawKind::SpringDamper
-            }
-            Law::Contact { .. } => LawKind::Contact,
-            Law::NlContact { .. } => LawKind::NlContact,
-            Law::NlSpring2 { .. } => LawKind::NlSpring2,
-            Law::NlSpring3 { .. } => LawKind::NlSpring3,
-            Law::NlSpringDamper { .. } => LawKind::NlSpringDamper,
-            Law::NlPluck { .. } => LawKind::Pluck,
-            Law::NlBow { .. } => LawKind::Bow,
-        }
+        self.form.kind()
     }
 
-    /// The law's arguments in its kind's column order ([`crate::laws::LawRow::columns`]), with `zero` for
-    /// a column the form leaves out (the Z of `spring`, the K of `damper`) and past the
-    /// kind's own columns.
+    /// The arguments as written (the form's columns, in order).
+    pub fn args(&self) -> &[Expr] {
+        &self.args
+    }
+
+    /// The arguments as written, to change.
+    pub fn args_mut(&mut self) -> &mut [Expr] {
+        &mut self.args
+    }
+
+    /// The argument of the column named `name` in the kind's row (`"K"`, `"Vscale"`…), if
+    /// the law has that column and its form writes it.
+    pub fn arg(&self, name: &str) -> Option<&Expr> {
+        let c = self
+            .kind()
+            .row()
+            .columns
+            .iter()
+            .position(|c| c.name == name)?;
+        let written = self.form.columns();
+        written.contains(&c).then(|| &self.args[c - written.start])
+    }
+
+    /// The law's arguments in its kind's column order ([`crate::laws::LawRow::columns`]),
+    /// with `zero` for a column the form leaves out (the Z of `spring`, the K of `damper`)
+    /// and past the kind's own columns.
     pub fn columns<'a>(&'a self, zero: &'a Expr) -> [&'a Expr; LawKind::MAX_ARITY] {
-        let z = zero;
-        match self {
-            Law::Spring { k } => [k, z, z, z, z],
-            Law::Damper { z: d } => [z, d, z, z, z],
-            Law::SpringDamper { k, z: d } => [k, d, z, z, z],
-            Law::Contact { k, z: d, thresh } => [k, d, thresh, z, z],
-            Law::NlContact {
-                k,
-                q,
-                klim,
-                z: d,
-                thresh,
-            } => [k, q, klim, d, thresh],
-            Law::NlSpring2 { k, q, z: d } | Law::NlSpring3 { k, q, z: d } => [k, q, d, z, z],
-            Law::NlSpringDamper { k, q, klim, z: d } => [k, q, klim, d, z],
-            Law::NlPluck { k, scale, z: d } => [k, scale, d, z, z],
-            Law::NlBow {
-                z: d,
-                scale,
-                smooth,
-            } => [d, scale, smooth, z, z],
-        }
-    }
-
-    /// The law of `kind` written with its own keyword, from its columns in order (the ones
-    /// past the kind's arity are ignored).
-    pub fn from_columns(kind: LawKind, columns: [Expr; LawKind::MAX_ARITY]) -> Law {
-        let [a, b, c, d, e] = columns;
-        match kind {
-            LawKind::SpringDamper => Law::SpringDamper { k: a, z: b },
-            LawKind::Contact => Law::Contact {
-                k: a,
-                z: b,
-                thresh: c,
-            },
-            LawKind::NlContact => Law::NlContact {
-                k: a,
-                q: b,
-                klim: c,
-                z: d,
-                thresh: e,
-            },
-            LawKind::NlSpring2 => Law::NlSpring2 { k: a, q: b, z: c },
-            LawKind::NlSpring3 => Law::NlSpring3 { k: a, q: b, z: c },
-            LawKind::NlSpringDamper => Law::NlSpringDamper {
-                k: a,
-                q: b,
-                klim: c,
-                z: d,
-            },
-            LawKind::Pluck => Law::NlPluck {
-                k: a,
-                scale: b,
-                z: c,
-            },
-            LawKind::Bow => Law::NlBow {
-                z: a,
-                scale: b,
-                smooth: c,
-            },
-        }
+        let written = self.form.columns();
+        std::array::from_fn(|c| {
+            if written.contains(&c) {
+                &self.args[c - written.start]
+            } else {
+                zero
+            }
+        })
     }
 
     /// The canonical keyword of the law.
     pub fn keyword(&self) -> &'static str {
-        match self {
-            Law::Spring { .. } => "spring",
-            Law::Damper { .. } => "damper",
-            _ => self.kind().row().keyword,
-        }
+        self.form.keyword()
     }
 }
 

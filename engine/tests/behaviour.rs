@@ -6,7 +6,7 @@ mod common;
 use common::{engine, hash_f64s, impulse, render};
 use ressort_engine::{
     compile, reference, CompileErrorKind, CompileOptions, Endpoint, Expr, Func, GuardKind, Law,
-    MacroKind, ModelBuilder, MotionStore, ScaleClass, StabilityWarning,
+    LawKind, MacroKind, ModelBuilder, MotionStore, ScaleClass, StabilityWarning,
 };
 use std::sync::Arc;
 
@@ -503,22 +503,16 @@ fn stability_report_names_masses_and_structures() {
     b.mass("m", 1.0, 0.0, 0.0).ground("g", 0.0);
     b.interaction(
         "n3",
-        Law::NlSpring3 {
-            k: 0.1.into(),
-            q: 2.0.into(),
-            z: 0.0.into(),
-        },
+        Law::new(LawKind::NlSpring3, [0.1.into(), 2.0.into(), 0.0.into()]),
         Endpoint::label("g"),
         Endpoint::label("m"),
     );
     b.interaction(
         "nb",
-        Law::NlSpringDamper {
-            k: 0.03.into(),
-            q: 0.005.into(),
-            klim: 0.8.into(),
-            z: 0.0002.into(),
-        },
+        Law::new(
+            LawKind::NlSpringDamper,
+            [0.03.into(), 0.005.into(), 0.8.into(), 0.0002.into()],
+        ),
         Endpoint::label("g"),
         Endpoint::label("m"),
     );

@@ -7,7 +7,7 @@ mod common;
 
 use common::{engine, impulse, render};
 use ressort_engine::{
-    Endpoint, Expr, Law, MacroKind, MacroSpec, ModelBuilder, ModelSpec, ScaleClass, Vector,
+    Endpoint, Expr, Law, LawKind, MacroKind, MacroSpec, ModelBuilder, ModelSpec, ScaleClass, Vector,
 };
 
 fn close(a: f64, b: f64) -> bool {
@@ -69,30 +69,11 @@ fn n(v: f64) -> Expr {
 fn linear_links() {
     // Δx = (0.1 + 0.02) − (0.5 − 0.01) = −0.37, Δv = 0.03.
     let (x1, v1, x2, v2) = (0.1, 0.02, 0.5, -0.01);
-    check_law(
-        "spring",
-        Law::Spring { k: n(0.3) },
-        x1,
-        v1,
-        x2,
-        v2,
-        0.3 * -0.37,
-    );
-    check_law(
-        "damper",
-        Law::Damper { z: n(0.2) },
-        x1,
-        v1,
-        x2,
-        v2,
-        0.2 * 0.03,
-    );
+    check_law("spring", Law::spring(n(0.3)), x1, v1, x2, v2, 0.3 * -0.37);
+    check_law("damper", Law::damper(n(0.2)), x1, v1, x2, v2, 0.2 * 0.03);
     check_law(
         "springDamper",
-        Law::SpringDamper {
-            k: n(0.3),
-            z: n(0.2),
-        },
+        Law::new(LawKind::SpringDamper, [n(0.3), n(0.2)]),
         x1,
         v1,
         x2,
@@ -103,11 +84,7 @@ fn linear_links() {
 
 #[test]
 fn contact_engaged_and_free() {
-    let law = || Law::Contact {
-        k: n(0.3),
-        z: n(0.2),
-        thresh: n(0.1),
-    };
+    let law = || Law::new(LawKind::Contact, [n(0.3), n(0.2), n(0.1)]);
     // Δx = 0.01 − 0.05 = −0.04 > −θ: engaged, f = K(Δx + θ) + ZΔv with Δv = 0.01.
     check_law(
         "contact engaged",
@@ -124,12 +101,11 @@ fn contact_engaged_and_free() {
 
 #[test]
 fn nl_contact_regions() {
-    let law = || Law::NlContact {
-        k: n(0.01),
-        q: n(0.1),
-        klim: n(0.4),
-        z: n(0.01),
-        thresh: n(0.0),
+    let law = || {
+        Law::new(
+            LawKind::NlContact,
+            [n(0.01), n(0.1), n(0.4), n(0.01), n(0.0)],
+        )
     };
     // Tipping distance b = √((0.4 − 0.01)/0.1) ≈ 1.975.
     // Cubic: Δx = 0.5, Δv = 0.02: f = 0.5(0.01 + 0.1·0.25) + 0.01·0.02.
@@ -162,11 +138,7 @@ fn nonlinear_springs() {
     let (x1, v1, x2, v2) = (-0.39, -0.01, 0.0, 0.0);
     check_law(
         "nlSpring2",
-        Law::NlSpring2 {
-            k: n(0.1),
-            q: n(0.5),
-            z: n(0.01),
-        },
+        Law::new(LawKind::NlSpring2, [n(0.1), n(0.5), n(0.01)]),
         x1,
         v1,
         x2,
@@ -175,22 +147,18 @@ fn nonlinear_springs() {
     );
     check_law(
         "nlSpring3",
-        Law::NlSpring3 {
-            k: n(0.1),
-            q: n(0.5),
-            z: n(0.01),
-        },
+        Law::new(LawKind::NlSpring3, [n(0.1), n(0.5), n(0.01)]),
         x1,
         v1,
         x2,
         v2,
         0.1 * -0.4 + 0.5 * -0.064 + 0.01 * -0.01,
     );
-    let nlsd = || Law::NlSpringDamper {
-        k: n(0.03),
-        q: n(0.005),
-        klim: n(0.8),
-        z: n(0.0002),
+    let nlsd = || {
+        Law::new(
+            LawKind::NlSpringDamper,
+            [n(0.03), n(0.005), n(0.8), n(0.0002)],
+        )
     };
     // b = √(0.77/0.005) ≈ 12.4. Cubic at Δx = 2: 2(0.03 + 0.005·4) + 0.0002·Δv, Δv = 0.1.
     check_law(
@@ -216,11 +184,7 @@ fn nonlinear_springs() {
 
 #[test]
 fn pluck_bands() {
-    let law = || Law::NlPluck {
-        k: n(0.5),
-        scale: n(0.1),
-        z: n(0.001),
-    };
+    let law = || Law::new(LawKind::Pluck, [n(0.5), n(0.1), n(0.001)]);
     // d_t = 0.01, K_e = 0.05. Inner band (Δx = 0.005, Δv = 0.004): no damping.
     check_law(
         "nlPluck inner",
@@ -247,11 +211,7 @@ fn pluck_bands() {
 
 #[test]
 fn bow_profiles() {
-    let bow = |smooth: f64| Law::NlBow {
-        z: n(1.2),
-        scale: n(0.001),
-        smooth: n(smooth),
-    };
+    let bow = |smooth: f64| Law::new(LawKind::Bow, [n(1.2), n(0.001), n(smooth)]);
     // Piecewise, v_t = scale/3. Stick at Δv = 0.0002: (Z − Z/3)Δv.
     check_law("nlBow stick", bow(0.0), 0.5, 0.0002, 0.0, 0.0, 0.8 * 0.0002);
     // Slip at Δv = −0.0005: sgn(Δv)·v_t·Z − (Z/3)·Δv.
@@ -275,11 +235,7 @@ fn bow_profiles() {
 #[test]
 fn law_is_symmetric_under_endpoint_swap() {
     // Spec §1.3: for laws odd in (Δx, Δv), swapping the endpoints gives identical physics.
-    let law = Law::NlSpring3 {
-        k: n(0.1),
-        q: n(0.5),
-        z: n(0.01),
-    };
+    let law = Law::new(LawKind::NlSpring3, [n(0.1), n(0.5), n(0.01)]);
     let mut b = ModelBuilder::new();
     b.raw();
     b.mass("m1", 1.0, 0.3, 0.01).mass("m2", 1.5, -0.2, 0.0);

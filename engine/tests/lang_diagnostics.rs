@@ -2,7 +2,7 @@
 //! the normative decisions of §3.12 a–f.
 
 use ressort_engine::lang::{parse, parse_bytes, Diagnostic, DiagnosticCode as C, Parsed, Severity};
-use ressort_engine::{ElementKind, Endpoint, Expr, Law, SampleRateMode, Vector};
+use ressort_engine::{ElementKind, Endpoint, Expr, Law, LawForm, LawKind, SampleRateMode, Vector};
 
 const PRELUDE: &str =
     "@K param 0.1\n@m mass 1 0 0\n@s string 10 1 K 0.001 0 0\n@me mesh 4 5 1 K 0.001 0 0\n";
@@ -790,27 +790,13 @@ fn legacy_forms() {
     let spec = p.spec.unwrap();
     let kind = |i: usize| &spec.elements[i].kind;
     assert!(matches!(kind(1), ElementKind::MassG { .. }));
-    assert!(matches!(
-        kind(2),
-        ElementKind::Interaction {
-            law: Law::SpringDamper { .. },
-            ..
-        }
-    ));
-    assert!(matches!(
-        kind(3),
-        ElementKind::Interaction {
-            law: Law::NlSpring2 { .. },
-            ..
-        }
-    ));
-    assert!(matches!(
-        kind(4),
-        ElementKind::Interaction {
-            law: Law::Spring { .. },
-            ..
-        }
-    ));
+    let form = |i: usize| match kind(i) {
+        ElementKind::Interaction { law, .. } => law.form(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(form(2), LawForm::Full(LawKind::SpringDamper));
+    assert_eq!(form(3), LawForm::Full(LawKind::NlSpring2));
+    assert_eq!(form(4), LawForm::Spring);
 }
 
 #[test]
@@ -823,22 +809,14 @@ fn optional_arguments_default_to_zero() {
     };
     assert_eq!(
         law,
-        &Law::NlPluck {
-            k: 1.0.into(),
-            scale: 2.0.into(),
-            z: 0.0.into()
-        }
+        &Law::new(LawKind::Pluck, [1.0.into(), 2.0.into(), 0.0.into()])
     );
     let ElementKind::Interaction { law, .. } = &spec.elements[3].kind else {
         panic!()
     };
     assert_eq!(
         law,
-        &Law::NlBow {
-            z: 1.0.into(),
-            scale: 2.0.into(),
-            smooth: 0.0.into()
-        }
+        &Law::new(LawKind::Bow, [1.0.into(), 2.0.into(), 0.0.into()])
     );
     let ElementKind::Osc { gravity, .. } = &spec.elements[5].kind else {
         panic!()

@@ -8,7 +8,7 @@ mod common;
 use common::{clean_spec, engine, impulse, render};
 use ressort_engine::generators::{generate, Fixed, Generator, LatticeFixed, Topology};
 use ressort_engine::lang::{parse, print};
-use ressort_engine::{ElementKind, Endpoint, Expr, Law, ModelBuilder, ModelSpec, Vector};
+use ressort_engine::{ElementKind, Endpoint, Expr, LawKind, ModelBuilder, ModelSpec, Vector};
 use std::collections::{HashMap, HashSet};
 
 /// The generated structure as found in a parsed spec: nodes (with fixedness and position) and
@@ -69,7 +69,7 @@ impl Graph {
             let ElementKind::Interaction { law, a, b } = &e.kind else {
                 continue;
             };
-            let Law::SpringDamper { k, z } = law else {
+            let (LawKind::SpringDamper, [k, z]) = (law.kind(), law.args()) else {
                 panic!("{}: links are springDampers", e.label);
             };
             let stiff = k == &Expr::param(&format!("{name}_Ks"));

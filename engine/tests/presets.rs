@@ -7,7 +7,7 @@ mod common;
 use common::{engine, render};
 use ressort_engine::spec::REFERENCE_SAMPLE_RATE_HZ;
 use ressort_engine::{
-    parse, reference, ElementKind, Endpoint, ExciterKind, InputUse, Law, ModelSpec, OutputUse,
+    parse, reference, ElementKind, Endpoint, ExciterKind, InputUse, LawKind, ModelSpec, OutputUse,
     ParamKind,
 };
 use std::path::PathBuf;
@@ -141,15 +141,15 @@ fn role(spec: &ModelSpec, avatar: &str) -> Role {
             if *a != me && *b != me {
                 continue;
             }
-            match law {
-                Law::NlBow { scale, .. } => {
+            match law.kind() {
+                LawKind::Bow => {
                     return Role::Bow {
-                        vscale: scale.eval(&value),
+                        vscale: law.arg("Vscale").unwrap().eval(&value),
                     }
                 }
-                Law::NlPluck { scale, .. } => {
+                LawKind::Pluck => {
                     return Role::Pluck {
-                        pscale: scale.eval(&value),
+                        pscale: law.arg("Pscale").unwrap().eval(&value),
                     }
                 }
                 _ => {}

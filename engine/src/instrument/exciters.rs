@@ -32,8 +32,9 @@
 //! in place.
 
 use super::prepare::{InputRole, Rejected};
+use crate::laws::LawKind;
 use crate::{ElementKind, Engine, ParamKind};
-use crate::{Endpoint, ExciterKind, Law, ModelSpec, SampleRateMode, REFERENCE_SAMPLE_RATE_HZ};
+use crate::{Endpoint, ExciterKind, ModelSpec, SampleRateMode, REFERENCE_SAMPLE_RATE_HZ};
 use std::f64::consts::PI;
 
 pub use crate::lang::MAX_EXCITERS;
@@ -264,13 +265,12 @@ pub fn resolve(
                     return None;
                 };
                 let _ = me;
-                match (d.kind, law) {
-                    (ExciterKind::Bow, Law::NlBow { scale, .. })
-                    | (ExciterKind::Pluck, Law::NlPluck { scale, .. }) => {
-                        Some((scale.eval(&lookup), other.clone()))
-                    }
+                let scale = match (d.kind, law.kind()) {
+                    (ExciterKind::Bow, LawKind::Bow) => law.arg("Vscale"),
+                    (ExciterKind::Pluck, LawKind::Pluck) => law.arg("Pscale"),
                     _ => None,
-                }
+                }?;
+                Some((scale.eval(&lookup), other.clone()))
             }
             _ => None,
         });

@@ -12,7 +12,8 @@
 use super::expr_parser::is_identifier;
 use crate::expr::{format_number, BinOp, Expr};
 use crate::spec::{
-    Element, ElementKind, Endpoint, Law, MacroSpec, ModelSpec, ParamKind, SampleRateMode, Vector,
+    Element, ElementKind, Endpoint, Law, LawForm, MacroSpec, ModelSpec, ParamKind, SampleRateMode,
+    Vector,
 };
 use std::fmt::Write;
 
@@ -144,21 +145,15 @@ fn is_zero(e: &Expr) -> bool {
 }
 
 fn law_args(law: &Law) -> (&'static str, Vec<&Expr>) {
-    match law {
-        Law::Spring { k } => ("spring", vec![k]),
-        Law::Damper { z } => ("damper", vec![z]),
-        _ => {
-            // The kind's columns; trailing optional ones equal to 0 are left out (they default
-            // to 0, §2.9).
-            static ZERO: Expr = Expr::Num(0.0);
-            let row = law.kind().row();
-            let mut args: Vec<&Expr> = law.columns(&ZERO)[..row.columns.len()].to_vec();
-            while args.len() > row.required && args.last().is_some_and(|e| is_zero(e)) {
-                args.pop();
-            }
-            (row.keyword, args)
+    // The written columns; a law's trailing optional ones equal to 0 are left out (they
+    // default to 0, §2.9).
+    let mut args: Vec<&Expr> = law.args().iter().collect();
+    if let LawForm::Full(kind) = law.form() {
+        while args.len() > kind.row().required && args.last().is_some_and(|e| is_zero(e)) {
+            args.pop();
         }
     }
+    (law.keyword(), args)
 }
 
 fn macro_args(m: &MacroSpec) -> Vec<String> {

@@ -6,11 +6,11 @@ use super::*;
 /// into an [`Expr`]: an `f64` literal, a `&str` parameter name, or an expression tree.
 ///
 /// ```
-/// use ressort_engine::{Endpoint, Law, ModelBuilder, MacroKind};
+/// use ressort_engine::{Endpoint, Law, LawKind, ModelBuilder, MacroKind};
 /// let mut b = ModelBuilder::new();
 /// b.param("K", 0.1).param("Z", 0.001);
 /// b.macro_1d("s", MacroKind::String, 42, 1.0, "K", "Z");
-/// b.interaction("hit", Law::Contact { k: 0.1.into(), z: 0.001.into(), thresh: 0.0.into() },
+/// b.interaction("hit", Law::new(LawKind::Contact, [0.1.into(), 0.001.into(), 0.0.into()]),
 ///               Endpoint::at("s", 0.13), Endpoint::label("h"));
 /// b.mass("h", 1.0, 0.1, 0.0);
 /// b.frc_input(1, Endpoint::label("h"));
@@ -230,10 +230,7 @@ impl ModelBuilder {
     ) -> &mut Self {
         self.interaction(
             label,
-            Law::SpringDamper {
-                k: k.into(),
-                z: z.into(),
-            },
+            Law::new(LawKind::SpringDamper, [k.into(), z.into()]),
             a,
             b,
         )
@@ -251,11 +248,7 @@ impl ModelBuilder {
     ) -> &mut Self {
         self.interaction(
             label,
-            Law::Contact {
-                k: k.into(),
-                z: z.into(),
-                thresh: thresh.into(),
-            },
+            Law::new(LawKind::Contact, [k.into(), z.into(), thresh.into()]),
             a,
             b,
         )

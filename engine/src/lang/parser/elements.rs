@@ -1,13 +1,14 @@
 //! Each element kind's arguments (spec §2.9): masses, interactions and their laws, macros,
 //! inputs and outputs.
 
-use super::keywords::{LawForm, Shape};
+use super::keywords::Shape;
 use super::{At, Builder, MAX_MACRO_NODES};
 use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::legacy;
 use crate::lang::lexer::Token;
 use crate::laws::LawKind;
+use crate::spec::LawForm;
 use crate::spec::{ElementKind, Law, MacroKind, MacroSpec};
 
 impl Builder<'_> {
@@ -189,15 +190,7 @@ impl Builder<'_> {
 /// `spring` (= springDamper, spec §3.12 a).
 fn make_law(form: LawForm, given: usize, p: [Expr; LawKind::MAX_ARITY]) -> Law {
     match form {
-        LawForm::Spring if given == 2 => Law::from_columns(LawKind::SpringDamper, p),
-        LawForm::Spring => {
-            let [k, ..] = p;
-            Law::Spring { k }
-        }
-        LawForm::Damper => {
-            let [z, ..] = p;
-            Law::Damper { z }
-        }
-        LawForm::Full(kind) => Law::from_columns(kind, p),
+        LawForm::Spring if given == 2 => Law::new(LawKind::SpringDamper, p),
+        form => Law::of_form(form, p),
     }
 }

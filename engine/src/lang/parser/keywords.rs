@@ -3,19 +3,7 @@
 
 use crate::lang::symbols::SymKind;
 use crate::laws::LawKind;
-use crate::spec::MacroKind;
-
-/// How a script writes an interaction (spec §2.9): a law under its own keyword, every column
-/// in order ([`LawKind::row`]), or one of the short forms of the spring-damper.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum LawForm {
-    /// The law's own keyword (or an alias of it).
-    Full(LawKind),
-    /// `spring m1 m2 K`, and the legacy `spring m1 m2 K Z` (spec §3.12 a).
-    Spring,
-    /// `damper m1 m2 Z`.
-    Damper,
-}
+use crate::spec::{LawForm, MacroKind};
 
 /// The argument shape a type keyword selects (spec §3.4, §2.9).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
