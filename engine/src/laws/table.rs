@@ -1,20 +1,21 @@
 //! The table of interaction laws: one row per kernel family of spec §2.3–§2.6.
 //!
-//! [`LawKind`] is the one list of laws, declared by [`laws!`] from one line per law: its
-//! variant and the type that implements [`Law`] in the law's own file. Everything else is
+//! [`LawKind`] is the one list of laws, declared by `laws!` from one line per law in
+//! `laws/mod.rs`: its variant and the type that implements [`super::Law`] in the law's own
+//! file. Everything else is
 //! derived from that list: `ALL` and `COUNT`, each law's [`LawRow`] (keyword, argument
-//! columns and classes, symmetry), its force on any [`Arith`], its slope for the analyses,
+//! columns and classes, symmetry), its force on any [`super::Arith`], its slope for the analyses,
 //! and the visit of every law in order that the kernels are written with
 //! ([`LawKind::visit_all`]). Every pass that walks the laws (the compiler's groups and bands,
 //! the kernels, the voice lanes, the native code, the linearisation of the analyses, the
 //! structure display) goes through these, so a law added here runs everywhere, and one that
 //! a pass forgot would be a compile error, not a silent omission.
 
-use super::linear::{BoundNote, Linear};
-use super::{Arith, Law};
+use super::LawKind;
 use crate::engine::ArgClass;
 
-/// Declares [`LawKind`] and its dispatch from one list of `Variant => LawType` lines.
+/// Declares [`LawKind`] and its dispatch from one list of `Variant => LawType` lines (the
+/// table, in `laws/mod.rs`).
 macro_rules! laws {
     ($($(#[$doc:meta])* $name:ident => $law:ty,)*) => {
         /// An interaction law, in the order of its group in the compiled model
@@ -34,32 +35,32 @@ macro_rules! laws {
             /// The law's row of the table.
             pub const fn row(self) -> LawRow {
                 match self {
-                    $(LawKind::$name => <$law as Law>::ROW,)*
+                    $(LawKind::$name => <$law as $crate::laws::Law>::ROW,)*
                 }
             }
 
             /// The law's force for the elongation `dx`, the relative velocity `dv` and its
             /// columns `p` (the caller applies F₁ −= f, F₂ += f).
             #[inline(always)]
-            pub(crate) fn force<A: Arith>(self, a: &A, dx: A::F, dv: A::F, p: &[A::F]) -> A::F {
+            pub(crate) fn force<A: $crate::laws::Arith>(self, a: &A, dx: A::F, dv: A::F, p: &[A::F]) -> A::F {
                 match self {
-                    $(LawKind::$name => <$law as Law>::force(a, dx, dv, |c| p[c]),)*
+                    $(LawKind::$name => <$law as $crate::laws::Law>::force(a, dx, dv, |c| p[c]),)*
                 }
             }
 
             /// The law's linear stand-in for the arguments `p` (its columns, per-step values):
             /// at its bounded tangent when `rest_dx` is `None` (the stability rule, spec
             /// §5.2), else at rest with elongation `rest_dx` and Δv = 0 (the modes, §5.5).
-            pub(crate) fn linearise(self, p: &[f64], rest_dx: Option<f64>) -> Linear {
+            pub(crate) fn linearise(self, p: &[f64], rest_dx: Option<f64>) -> $crate::laws::linear::Linear {
                 match self {
-                    $(LawKind::$name => <$law as Law>::linearise(p, rest_dx),)*
+                    $(LawKind::$name => <$law as $crate::laws::Law>::linearise(p, rest_dx),)*
                 }
             }
 
             /// What the stability rule notes of the arguments `p`, if anything.
-            pub(crate) fn bound_note(self, p: &[f64]) -> Option<BoundNote> {
+            pub(crate) fn bound_note(self, p: &[f64]) -> Option<$crate::laws::linear::BoundNote> {
                 match self {
-                    $(LawKind::$name => <$law as Law>::bound_note(p),)*
+                    $(LawKind::$name => <$law as $crate::laws::Law>::bound_note(p),)*
                 }
             }
 
@@ -67,36 +68,19 @@ macro_rules! laws {
             /// straight-line code with each law's force inlined (a loop over [`LawKind::ALL`]
             /// with a `match` inside measured 30 % slower on a 100-mass string).
             #[inline(always)]
-            pub(crate) fn visit_all(v: &mut impl LawVisitor) {
+            pub(crate) fn visit_all(v: &mut impl $crate::laws::LawVisitor) {
                 $(v.visit::<$law>(LawKind::$name);)*
             }
         }
     };
 }
 
+pub(super) use laws;
+
 /// Code run once per law, with the law's type ([`LawKind::visit_all`]).
 pub(crate) trait LawVisitor {
     /// Runs for law `kind`, whose force is `L`'s.
-    fn visit<L: Law>(&mut self, kind: LawKind);
-}
-
-laws! {
-    /// `spring`, `damper`, `springDamper` (spec §2.3): f = K·Δx + Z·Δv.
-    SpringDamper => super::spring_damper::SpringDamper,
-    /// `contact` (spec §2.4.1).
-    Contact => super::contact::Contact,
-    /// `nlContact` (spec §2.4.2).
-    NlContact => super::nl_contact::NlContact,
-    /// `nlSpring2` (spec §2.5.1).
-    NlSpring2 => super::nl_spring2::NlSpring2,
-    /// `nlSpring3` (spec §2.5.2).
-    NlSpring3 => super::nl_spring3::NlSpring3,
-    /// `nlSpringDamper` (spec §2.5.3).
-    NlSpringDamper => super::nl_spring_damper::NlSpringDamper,
-    /// `nlPluck` (spec §2.6.1).
-    Pluck => super::pluck::Pluck,
-    /// `nlBow` (spec §2.6.2).
-    Bow => super::bow::Bow,
+    fn visit<L: super::Law>(&mut self, kind: LawKind);
 }
 
 /// One argument column of a law: its name in the spec's signature and the class its value is
