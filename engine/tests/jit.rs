@@ -5,7 +5,7 @@
 
 use ressort_engine::{compile, parse, CompileOptions, Engine, ParamId, ScaleClass};
 
-/// Every law, both bow profiles, avatars, massG and osc, gravity, a ground at −0, force
+/// Every law of the table (a test below holds it to that), both bow profiles, avatars, massG and osc, gravity, a ground at −0, force
 /// outputs, an output on an avatar.
 const MIXED: &str = "\
 @K param 0.1
@@ -316,4 +316,17 @@ fn random_networks_equal_the_interpreter() {
         native_models > 100,
         "{native_models} models ran native code"
     );
+}
+
+/// MIXED writes every law of the table, so that each runs in native code against the
+/// interpreter.
+#[test]
+fn the_mixed_model_writes_every_law() {
+    for kind in ressort_engine::LawKind::ALL {
+        let keyword = kind.row().keyword;
+        assert!(
+            MIXED.contains(&format!(" {keyword} ")),
+            "MIXED has no {keyword}"
+        );
+    }
 }

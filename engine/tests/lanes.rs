@@ -18,8 +18,8 @@ fn published(name: &str) -> ModelSpec {
     spec(&std::fs::read_to_string(path).unwrap())
 }
 
-/// An element-by-element string with a plucked and a bowed point, every linear and
-/// nonlinear law the lanes run, two force inputs and a force output.
+/// An element-by-element network with every law of the table (a test below holds it to
+/// that), both bow profiles, two force inputs and a force output.
 const MIXED: &str = "\
 @g ground 0.
 @m1 mass 1. 0. 0.
@@ -36,6 +36,10 @@ const MIXED: &str = "\
 @r6 springDamper @m5 @g2 0.1 0.001
 @c contact @m2 @m5 0.05 0.001 0.
 @p nlPluck @m3 @g 0.05 0.001 0.001
+@n nlContact @m1 @m5 0.01 100. 0.5 0.001 0.01
+@r7 nlSpringDamper @m2 @m4 0.05 10. 0.2 0.001
+@b nlBow @m4 @g 0.005 0.0001 1
+@b2 nlBow @m1 @g 0.005 0.0001
 @in1 frcInput @m1
 @in2 frcInput @m4
 @out1 posOutput @m3
@@ -292,4 +296,16 @@ fn a_lane_resets_and_trips_alone() {
     let mut rest = template.clone();
     rest.reset();
     assert_eq!(&x[..], &rest.positions()[..x.len()]);
+}
+
+/// MIXED writes every law of the table, so that each runs in lanes against the plain engine.
+#[test]
+fn the_mixed_model_writes_every_law() {
+    for kind in ressort_engine::LawKind::ALL {
+        let keyword = kind.row().keyword;
+        assert!(
+            MIXED.contains(&format!(" {keyword} ")),
+            "MIXED has no {keyword}"
+        );
+    }
 }
