@@ -4,16 +4,13 @@
 //! **Per-mass rule** (SMC'19 paper): every moving mass must satisfy 4M > K_eq + 2·Z_eq, where
 //! K_eq and Z_eq sum the stiffness and damping of everything attached to it:
 //!
-//! * linear links and contacts (counted as engaged) with their K and Z;
 //! * `osc` elements and macro nodes with their own K and Z, or Z_o;
-//! * bounded nonlinear links at their bounded tangent stiffness: k for the bounded branch, and
-//!   3k − 2s, the peak of the cubic region just below the tipping point (derived, §2.5.3), when
-//!   the cubic region exists; `nlSpringDamper` also counts its bounded-region damping Z + 0.3k;
-//! * `nlSpring2`/`nlSpring3` at their linear K (their tangent stiffness is unbounded, which is
-//!   reported as a warning when Q ≠ 0);
-//! * `nlPluck` at 0.9·K, the steepest slope of its tent, and its Z;
-//! * `nlBow` by its stick slope in Z_eq: 2/3·Z for the piecewise profile, 0.63·e^½·Z ≈ 1.04·Z
-//!   for the smooth one (the slope of its law at Δv = 0).
+//! * every link by its law's linear stand-in at its bound (`LawKind::linearise`, described in
+//!   each law's file under `laws/`): linear links and contacts (counted as engaged) with their
+//!   K and Z; bounded nonlinear links at their bounded tangent, k for the bounded branch and
+//!   3k − 2s, the peak of the cubic region just below the tipping point (derived, §2.5.3);
+//!   unbounded ones at their linear part, with a warning; `nlPluck` at the steepest slope of
+//!   its tent; `nlBow` by its stick slope in Z_eq.
 //!
 //! A link attached to a connection point acts on the macro nodes through the interpolation
 //! weights w; each node counts w·K and w·Z (the row sum of the spread stiffness).
@@ -86,7 +83,7 @@ pub enum StabilityWarning {
         keyword: &'static str,
         load: f64,
     },
-    /// A nonlinear spring without a bound (`nlSpring2`/`nlSpring3` with Q ≠ 0). For the link
+    /// A nonlinear law without a bound (`nlSpring2`/`nlSpring3` with Q ≠ 0, for example). For the link
     /// warnings, `label` names the link's endpoints (`g–m`) and `element` is the index of the
     /// interaction in the spec's elements (its label and line).
     Unbounded {
