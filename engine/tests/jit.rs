@@ -32,6 +32,7 @@ const MIXED: &str = "\
 @p nlPluck @m3 @in2 0.05 0.01 0.001
 @b nlBow @m4 @in3 0.005 0.0001 1
 @b2 nlBow @m1 @in3 0.005 0.0001
+@f feltContact @m2 @m6 0.5 2.5 0.001 0.01
 @in1 frcInput @m1
 @in4 frcInput @m4
 @out1 posOutput @m3

@@ -40,6 +40,7 @@ const MIXED: &str = "\
 @r7 nlSpringDamper @m2 @m4 0.05 10. 0.2 0.001
 @b nlBow @m4 @g 0.005 0.0001 1
 @b2 nlBow @m1 @g 0.005 0.0001
+@f feltContact @m2 @m3 0.5 2.5 0.001 0.01
 @in1 frcInput @m1
 @in2 frcInput @m4
 @out1 posOutput @m3

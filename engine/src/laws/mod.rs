@@ -21,6 +21,7 @@ mod table;
 // The laws, one file each.
 mod bow;
 mod contact;
+mod felt;
 mod nl_contact;
 mod nl_spring2;
 mod nl_spring3;
@@ -46,6 +47,8 @@ table::laws! {
     Pluck => pluck::Pluck,
     /// `nlBow` (spec §2.6.2).
     Bow => bow::Bow,
+    /// `feltContact`, a power-law (Hertzian) contact: a piano hammer's felt.
+    Felt => felt::Felt,
 }
 
 #[cfg(test)]
