@@ -69,6 +69,7 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("two-fingers-string.mdl", Some((127, 258))),
     // Ressort's own: the counts its header gives.
     ("struck-string.mdl", Some((20, 19))),
+    ("felt-piano.mdl", Some((32, 61))),
     // §7.6 Oscillator tutorial series: no counts given.
     ("harmonic-oscillator.mdl", None),
     ("hammer-oscillator.mdl", None),

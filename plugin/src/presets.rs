@@ -28,6 +28,7 @@ pub const PRESETS: &[Preset] = presets![
     "bowed-string",
     "plucked-harmonics",
     "struck-string",
+    "felt-piano",
     "harmonic-oscillator",
     "hammer-oscillator",
     "gravity-oscillator",
