@@ -700,3 +700,54 @@ fn an_exciter_an_input_cannot_take_is_an_error_at_its_directive() {
         assert!(first.starts_with(expected), "{script:?}: {first}");
     }
 }
+
+/// The spectral centroid of the first half second of `signal`, in Hz (Hann window).
+fn attack_centroid(signal: &[f64], sr: f64) -> f64 {
+    let n = (0.5 * sr) as usize;
+    let mut frame: Vec<f64> = signal[..n]
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v * (0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / n as f64).cos()))
+        .collect();
+    let mut spectrum = realfft::RealFftPlanner::<f64>::new()
+        .plan_fft_forward(n)
+        .make_output_vec();
+    realfft::RealFftPlanner::<f64>::new()
+        .plan_fft_forward(n)
+        .process(&mut frame, &mut spectrum)
+        .unwrap();
+    let (mut weighted, mut total) = (0.0, 0.0);
+    for (k, c) in spectrum.iter().enumerate() {
+        let f = k as f64 * sr / n as f64;
+        weighted += f * c.norm();
+        total += c.norm();
+    }
+    weighted / total
+}
+
+/// The felt of Felt Piano (`feltContact`, p = 2.5) hardens as it is pressed, so a harder key
+/// is brighter, not only louder; a linear contact on the same wire is not.
+#[test]
+fn a_harder_key_on_the_felt_piano_is_brighter() {
+    const SR: f64 = 48_000.0;
+    let felt = preset("felt-piano");
+    let linear = felt.replace(
+        "@hit feltContact [@s 0.12] @h 0.003 2.5 0.0005",
+        "@hit contact [@s 0.12] @h 0.01 0.001",
+    );
+    assert_ne!(felt, linear, "the felt line is in the preset");
+    let rise = |script: &str| {
+        let mut p = Player::new(script, SR);
+        let soft = attack_centroid(&p.note(60, 0.2, 1.0).left(), SR);
+        let hard = attack_centroid(&p.note(60, 1.0, 1.0).left(), SR);
+        println!("centroid at C4: {soft:.0} Hz at velocity 0.2, {hard:.0} Hz at 1.0");
+        hard / soft
+    };
+    let felt_rise = rise(&felt);
+    let linear_rise = rise(&linear);
+    assert!(felt_rise > 1.25, "the felt brightens by {felt_rise:.2}");
+    assert!(
+        linear_rise < 1.05,
+        "the linear contact brightens by {linear_rise:.2}"
+    );
+}
