@@ -541,8 +541,13 @@ fn preset_names() -> Vec<String> {
     names
 }
 
-/// On every preset the exact limit applies and is at least the Gershgorin bound (a diagonally
-/// dominant 4M − K − 2Z is positive definite).
+/// Presets with negative springs: Felt Piano writes its wire's bending stiffness as negative
+/// second-neighbour springs. The per-mass rule sums signed stiffnesses, so a negative spring
+/// lowers a mass's load and the rule's limit is no longer a bound from below.
+const NEGATIVE_SPRINGS: [&str; 1] = ["felt-piano.mdl"];
+
+/// On every preset the exact limit applies and, where every link is a positive spring, is at
+/// least the Gershgorin bound (a diagonally dominant 4M − K − 2Z is positive definite).
 #[test]
 fn exact_limit_is_never_below_the_gershgorin_bound_on_the_presets() {
     for name in preset_names() {
@@ -552,8 +557,33 @@ fn exact_limit_is_never_below_the_gershgorin_bound_on_the_presets() {
             panic!("{name}: the exact analysis does not apply");
         };
         eprintln!("{name}: Gershgorin ×{gersh:.4}, exact ×{exact:.4}");
-        assert!(exact >= gersh * (1.0 - 1e-9), "{name}: {exact} < {gersh}");
+        if !NEGATIVE_SPRINGS.contains(&name.as_str()) {
+            assert!(exact >= gersh * (1.0 - 1e-9), "{name}: {exact} < {gersh}");
+        }
     }
+}
+
+/// With negative springs the exact limit is where the model blows up: Felt Piano's wire,
+/// struck at 0.98 and at 1.1 times it (the rule's bound, 8 % above it, would let it diverge).
+#[test]
+fn exact_limit_holds_with_negative_springs() {
+    let text = preset("felt-piano.mdl");
+    let mut e = engine(&text, 44_100.0);
+    let exact = e.stiffness_limit(1.0);
+    let StiffnessLimit::Exact(exact) = exact else {
+        panic!("the exact analysis applies to a wire with bending springs");
+    };
+    assert!(e.gershgorin_stiffness_limit(1.0) > exact);
+    let peak = |gain: f64| {
+        let mut e = engine(&text, 44_100.0);
+        e.set_class_gain(ScaleClass::Stiffness, gain);
+        let strike = impulse(-0.05, 40_000);
+        let out = &render(&mut e, 40_000, 64, &[strike])[0];
+        out.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    };
+    let (below, above) = (peak(0.98 * exact), peak(1.1 * exact));
+    assert!(below.is_finite() && below < 10.0, "{below}");
+    assert!(!(above < 1e3), "{above}: not diverging above the limit");
 }
 
 /// The modal reference pitch against the strongest FFT peak of a rendered impulse response on

@@ -19,9 +19,11 @@
 //! reach. With the Stiffness gain g and the Damping gain h, K = g·K₁ and Z = h·Z₁ + g·Z_K
 //! (Z_K is the K-class part of `nlSpringDamper`'s bounded damping 0.3·k), and the limit is the
 //! largest g (or h) that keeps 4M − g·(K₁ + 2Z_K) − 2h·Z₁ positive definite, found by
-//! bisection on the success of a sparse Cholesky factorisation. Where the network has a
-//! negative stiffness or damping, the energy argument does not hold and the Gershgorin bound
-//! of [`crate::instrument`]'s envelope remains.
+//! bisection on the success of a sparse Cholesky factorisation. The energy argument needs
+//! K₁ + 2Z_K ⪰ 0 and Z₁ ⪰ 0 as matrices, not each link: a network with a negative spring (a
+//! stiff wire's bending written as negative second-neighbour springs) qualifies when the
+//! assembled matrices are positive semi-definite. Where they are not, the Gershgorin bound of
+//! [`crate::instrument`]'s envelope remains.
 
 use super::system::{SymSparse, System};
 use crate::network::{Network, Valuation};
@@ -31,6 +33,10 @@ use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholes
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Par, Side};
 use std::sync::Arc;
+
+/// The inverse of the tolerance of the positive semi-definite test of a network with negative
+/// links: A ⪰ −10⁻⁹·4M.
+const SEMIDEFINITE_SCALE: f64 = 1e9;
 
 /// Bisection steps: the limit to 2⁻⁴⁰ of its bracket.
 const BISECTION_STEPS: usize = 40;
@@ -105,8 +111,9 @@ impl Terms {
 }
 
 impl ExactStability {
-    /// False when the network has a negative stiffness or damping (an `nlPluck` resting in
-    /// its tent, a negative script value): the criterion then does not apply.
+    /// False when the network's stiffness or damping matrix is not positive semi-definite (a
+    /// negative script value that the rest of the network does not outweigh): the criterion
+    /// then does not apply.
     pub fn applies(&self) -> bool {
         self.applies
     }
@@ -225,11 +232,10 @@ impl Engine {
         let a_z = SymSparse::combine(2.0, &z_side.z, 0.0, &z_side.k, &vec![0.0; z_side.len()]);
         let four_m: Vec<f64> = k_side.mass.iter().map(|m| 4.0 * m).collect();
         let net = Network::walk(self, Valuation::Bound);
-        let applies = four_m.iter().all(|m| m.is_finite() && *m > 0.0)
-            && net.links.iter().all(|l| l.k >= 0.0 && l.z >= 0.0)
-            && net.k_ground.iter().chain(&net.z_ground).all(|v| *v >= 0.0)
-            && a_k.is_finite()
-            && a_z.is_finite();
+        let finite =
+            four_m.iter().all(|m| m.is_finite() && *m > 0.0) && a_k.is_finite() && a_z.is_finite();
+        let nonnegative = net.links.iter().all(|l| l.k >= 0.0 && l.z >= 0.0)
+            && net.k_ground.iter().chain(&net.z_ground).all(|v| *v >= 0.0);
         let (pattern, terms) = entry_terms(&a_k, &a_z, &four_m);
         let symbolic = factorize_symbolic_cholesky(
             pattern.as_ref(),
@@ -239,12 +245,22 @@ impl Engine {
         )
         .ok()
         .map(Arc::new);
-        ExactStability {
+        let mut stability = ExactStability {
             pattern,
             terms,
-            applies,
+            applies: finite,
             symbolic,
+        };
+        if finite && !nonnegative {
+            // A negative spring or damper: the energy argument needs only the assembled
+            // K₁ + 2Z_K and Z₁ to be positive semi-definite, as they are for a wire whose
+            // bending stiffness is written as negative second-neighbour springs. Tested as
+            // A + 10⁻⁹·4M ≻ 0, that is 4M + 10⁹·A ≻ 0 (gains of −10⁹).
+            let mut ws = stability.workspace();
+            stability.applies = stability.positive_definite(&mut ws, -SEMIDEFINITE_SCALE, 0.0)
+                && stability.positive_definite(&mut ws, 0.0, -SEMIDEFINITE_SCALE);
         }
+        stability
     }
 
     /// The largest Stiffness gain that keeps the model stable at Damping gain `damping_gain`:
