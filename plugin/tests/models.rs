@@ -38,8 +38,13 @@ fn every_preset_prepares_at_every_common_rate() {
     }
 }
 
+/// Presets with negative springs: Felt Piano writes its wire's bending stiffness as negative
+/// second-neighbour springs.
+const NEGATIVE_SPRINGS: [&str; 1] = ["felt-piano"];
+
 /// The clamp's limit: the exact stability limit of the linear network (issue 14) with the
-/// headroom, where it applies — never below the coupled (Gershgorin) bound it replaces, and
+/// headroom, where it applies — never below the coupled (Gershgorin) bound it replaces (on
+/// networks of positive springs), and
 /// stable there by the exact criterion; elsewhere the Gershgorin bound, where the worst mass
 /// reaches the headroom.
 #[test]
@@ -61,11 +66,15 @@ fn the_stiffness_limit_matches_the_stability_analysis() {
                     "{}: clamp ×{limit} beyond the headroom of the exact limit ×{e}",
                     preset.id
                 );
-                assert!(
-                    limit >= bound * (1.0 - 1e-9),
-                    "{}: ×{limit} < bound ×{bound}",
-                    preset.id
-                );
+                // The per-mass rule sums signed stiffnesses, so with negative springs (Felt
+                // Piano's bending) its figure is no bound and the exact limit is below it.
+                if !NEGATIVE_SPRINGS.contains(&preset.id) {
+                    assert!(
+                        limit >= bound * (1.0 - 1e-9),
+                        "{}: ×{limit} < bound ×{bound}",
+                        preset.id
+                    );
+                }
                 assert_eq!(exact.is_stable(limit, 1.0), Some(true), "{}", preset.id);
                 println!(
                     "{:<22} stiffness limit ×{limit:9.3} (exact ×{e:9.3}, Gershgorin ×{bound:9.3})",
