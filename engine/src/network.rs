@@ -20,7 +20,6 @@ use crate::engine::{Engine, Group};
 use crate::info::PointKind;
 use crate::laws::linear::{BoundNote, Linear};
 use crate::laws::LawKind;
-use crate::stability::StabilityWarning;
 
 /// How nonlinear laws are linearised.
 #[derive(Clone, Copy, Debug)]
@@ -42,6 +41,17 @@ pub(crate) struct Link {
     pub z: f64,
 }
 
+/// A law's note on one link ([`LawKind::bound_note`]).
+#[derive(Clone, Debug)]
+pub(crate) struct LinkNote {
+    pub note: BoundNote,
+    /// The link's endpoints, `g–m`.
+    pub label: String,
+    pub keyword: &'static str,
+    /// The interaction's index in the spec's elements.
+    pub element: u32,
+}
+
 /// The linear network of a compiled model.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Network {
@@ -54,8 +64,9 @@ pub(crate) struct Network {
     pub z_ground: Vec<f64>,
     /// Every link, explicit interactions first (in law order), then macro-internal links.
     pub links: Vec<Link>,
-    /// What the bounded valuation wants the user to know (empty for [`Valuation::Rest`]).
-    pub warnings: Vec<StabilityWarning>,
+    /// What the bounded valuation notes of the laws' arguments (empty for
+    /// [`Valuation::Rest`]); the stability report words them.
+    pub notes: Vec<LinkNote>,
     /// The endpoints of the contacts open at rest ([`Valuation::Rest`] only): the paths a
     /// strike takes.
     pub open_contacts: Vec<(u32, u32)>,
@@ -108,7 +119,7 @@ impl Network {
             k_ground: vec![0.0; n],
             z_ground: vec![0.0; n],
             links: Vec::new(),
-            warnings: Vec::new(),
+            notes: Vec::new(),
             open_contacts: Vec::new(),
         };
         let ix = &e.interactions;
@@ -152,20 +163,11 @@ impl Network {
                     Valuation::Rest(_) => None,
                 };
                 if let Some(note) = note {
-                    let (label, element) = (endpoints(g, i), g.elements[i]);
-                    let keyword = kind.row().keyword;
-                    net.warnings.push(match note {
-                        BoundNote::NegativeCubic => StabilityWarning::NegativeCubic {
-                            label,
-                            keyword,
-                            element,
-                        },
-                        BoundNote::Unbounded => StabilityWarning::Unbounded {
-                            label,
-                            keyword,
-                            element,
-                        },
-                        BoundNote::WeakBound => StabilityWarning::WeakBound { label, element },
+                    net.notes.push(LinkNote {
+                        note,
+                        label: endpoints(g, i),
+                        keyword: kind.row().keyword,
+                        element: g.elements[i],
                     });
                 }
                 match kind.linearise(a, rest_dx(g, i)) {

@@ -23,6 +23,7 @@
 //! K < 4K_s and 4K otherwise.
 
 use crate::engine::Engine;
+use crate::laws::linear::BoundNote;
 use crate::network::{endpoint_nodes, kind_moves, Network, Valuation};
 use std::fmt;
 
@@ -220,7 +221,26 @@ fn analyze(e: &Engine, labelled: bool) -> StabilityReport {
     let mut z_eq = net.z_ground.clone();
     let mut k_cp = vec![0.0; n];
     let mut z_cp = vec![0.0; n];
-    let mut warnings = net.warnings.clone();
+    let mut warnings: Vec<StabilityWarning> = net
+        .notes
+        .iter()
+        .map(|n| {
+            let (label, keyword, element) = (n.label.clone(), n.keyword, n.element);
+            match n.note {
+                BoundNote::NegativeCubic => StabilityWarning::NegativeCubic {
+                    label,
+                    keyword,
+                    element,
+                },
+                BoundNote::Unbounded => StabilityWarning::Unbounded {
+                    label,
+                    keyword,
+                    element,
+                },
+                BoundNote::WeakBound => StabilityWarning::WeakBound { label, element },
+            }
+        })
+        .collect();
 
     let is_moving = |p: usize| -> bool { kind_moves(info.points[p].kind) };
     // The share of an endpoint that moves: 1 or 0 for a point, the weights of its moving
