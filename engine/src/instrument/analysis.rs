@@ -5,8 +5,9 @@
 //! The copy is taken when the model is prepared, off the audio thread, and analysed on a
 //! worker thread: nothing here runs in `process()`.
 
-use super::controls::{ClampView, Controls, Gains, Smoothed};
+use super::controls::{ClampView, Controls, Smoothed};
 use super::envelope::StabilityEnvelope;
+use super::gains::Gains;
 use super::macros::MacroBinding;
 use super::prepare::Prepared;
 use crate::modes::ModalAnalysis;

@@ -7,10 +7,11 @@
 
 use super::dsp::{db_to_gain, tuning_gain, ChunkSmoother};
 use super::envelope::StabilityEnvelope;
+use super::gains::{Controlled, ControlsKey, Gains, TuningMemo};
 use super::macros::MacroBinding;
 use super::prepare::Prepared;
 use super::{CHUNK, NUM_MACROS};
-use crate::{Engine, ParamId, ScaleClass};
+use crate::ScaleClass;
 
 /// The range of the A4 reference, Hz.
 pub const A4_RANGE_HZ: (f64, f64) = (400.0, 480.0);
@@ -128,75 +129,7 @@ impl Default for Controls {
     }
 }
 
-/// The gains in use after the last chunk, for meters and the editor.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Gains {
-    /// After the stability clamp.
-    pub stiffness: f64,
-    pub damping: f64,
-    /// Asked for (Stiffness × Tune × note pitch), before the clamp.
-    pub requested_stiffness: f64,
-    pub requested_damping: f64,
-    /// True while the clamp holds a gain below what was asked for.
-    pub clamped: bool,
-}
-
-impl Default for Gains {
-    fn default() -> Self {
-        Gains {
-            stiffness: 1.0,
-            damping: 1.0,
-            requested_stiffness: 1.0,
-            requested_damping: 1.0,
-            clamped: false,
-        }
-    }
-}
-
 /// The smoothed controls, advanced once per chunk.
-/// What the controls act on: a model's engine, or one voice of a bank.
-pub trait Controlled {
-    fn set_class_gain(&mut self, class: ScaleClass, gain: f64);
-    /// Ignores values the parameter cannot take (the controls only send finite ones).
-    fn set_param(&mut self, id: ParamId, value: f64);
-}
-
-impl Controlled for Engine {
-    fn set_class_gain(&mut self, class: ScaleClass, gain: f64) {
-        Engine::set_class_gain(self, class, gain);
-    }
-    fn set_param(&mut self, id: ParamId, value: f64) {
-        let _ = Engine::set_param(self, id, value);
-    }
-}
-
-/// The smoothed controls a voice's gains read, bit for bit ([`Smoothed::controls_key`]).
-pub type ControlsKey = [u64; 3 + NUM_MACROS];
-
-/// The inputs of one voice's gains, bit for bit ([`TuneKey::new`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct TuneKey {
-    smoothed: ControlsKey,
-    voice: [u64; 4],
-}
-
-impl TuneKey {
-    /// Everything [`Smoothed::gains_offset`] and [`Smoothed::set`] read for one voice: when
-    /// it has not changed since the voice was last tuned, neither have its gains.
-    pub fn new(
-        controls: &ControlsKey,
-        note_st: f64,
-        z_factor: f64,
-        k_octaves: f64,
-        z_octaves: f64,
-    ) -> TuneKey {
-        TuneKey {
-            smoothed: *controls,
-            voice: [note_st, z_factor, k_octaves, z_octaves].map(f64::to_bits),
-        }
-    }
-}
-
 #[derive(Clone, Debug, Default)]
 pub(super) struct Smoothed {
     stiffness: ChunkSmoother,
@@ -256,14 +189,6 @@ impl Pow2 {
         }
     }
 }
-
-/// A voice's tuning gain (`tuning_gain`) for the last semitones, reference pitch and sample
-/// rate: its note rarely moves while the controls do.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct TuningMemo(Option<(TuningInputs, f64)>);
-
-/// The bits of a tuning gain's inputs: semitones, reference pitch, sample rate.
-type TuningInputs = (u64, Option<u64>, u64);
 
 impl Smoothed {
     /// Every smoother on its target: a fresh start.

@@ -27,6 +27,7 @@ pub mod dsp;
 pub mod envelope;
 pub mod events;
 pub mod exciters;
+pub mod gains;
 pub mod host;
 pub mod level;
 pub mod macros;
@@ -37,9 +38,10 @@ pub mod units;
 pub mod voices;
 
 pub use analysis::{ModalModel, ModesAtControls};
-pub use controls::{Controls, Gains};
+pub use controls::Controls;
 pub use envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
 pub use events::{Event, Timed};
+pub use gains::Gains;
 pub use host::HostSettings;
 pub use macros::MacroBinding;
 pub use prepare::{
@@ -48,8 +50,9 @@ pub use prepare::{
 };
 
 use crate::RouteSource;
-use controls::{ClampView, ControlsKey, Smoothed, TuneKey};
+use controls::{ClampView, Smoothed};
 use events::Modulated;
+use gains::{ControlsKey, TuneKey};
 use output::{OutputStage, Span};
 pub use voices::{Drive, Ended, VoiceBank, VoiceState};
 

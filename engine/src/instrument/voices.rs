@@ -13,8 +13,8 @@
 //! comes to rest does not matter: gravity and contacts leave static offsets (a dropped mass
 //! lies on its triangle, away from where it started).
 
-use super::controls::{Controlled, Gains, TuneKey, TuningMemo};
 use super::exciters::{self, Exciter, Gestures};
+use super::gains::{Controlled, Gains, TuneKey, TuningMemo};
 use super::CHUNK;
 use crate::lanes::{LaneEngine, LANES};
 use crate::{Engine, ParamId, ScaleClass};
