@@ -2,14 +2,13 @@
 //!
 //! [`LawKind`] is the one list of laws, declared by `laws!` from one line per law in
 //! `laws/mod.rs`: its variant and the type that implements [`super::Law`] in the law's own
-//! file. Everything else is
-//! derived from that list: `ALL` and `COUNT`, each law's [`LawRow`] (keyword, argument
-//! columns and classes, symmetry), its force on any [`super::Arith`], its slope for the analyses,
-//! and the visit of every law in order that the kernels are written with
-//! ([`LawKind::visit_all`]). Every pass that walks the laws (the compiler's groups and bands,
-//! the kernels, the voice lanes, the native code, the linearisation of the analyses, the
-//! structure display) goes through these, so a law added here runs everywhere, and one that
-//! a pass forgot would be a compile error, not a silent omission.
+//! file. Everything else is derived from that list: `ALL` and `COUNT`, each law's [`LawRow`]
+//! (keyword, argument columns and classes, symmetry), its force on any [`super::Arith`], its
+//! slope for the analyses, and the visit of every law in order that the kernels are written
+//! with ([`LawKind::visit_all`]). Every pass that walks the laws (the compiler's groups and
+//! bands, the kernels, the voice lanes, the native code, the linearisation of the analyses,
+//! the structure display) goes through these, so a law added here runs everywhere, and one
+//! that a pass forgot would be a compile error, not a silent omission.
 
 use super::LawKind;
 use crate::engine::ArgClass;
