@@ -3,6 +3,8 @@
 //! counts, through odd block sizes, strikes, noise, non-finite input, parameter and gain
 //! changes, guard trips and resets.
 
+mod common;
+
 use ressort_engine::{compile, parse, CompileOptions, Engine, ParamId, ScaleClass};
 
 /// Every law of the table (a test below holds it to that), both bow profiles, avatars, massG and osc, gravity, a ground at −0, force
@@ -323,11 +325,5 @@ fn random_networks_equal_the_interpreter() {
 /// interpreter.
 #[test]
 fn the_mixed_model_writes_every_law() {
-    for kind in ressort_engine::LawKind::ALL {
-        let keyword = kind.row().keyword;
-        assert!(
-            MIXED.contains(&format!(" {keyword} ")),
-            "MIXED has no {keyword}"
-        );
-    }
+    common::assert_writes_every_law(MIXED);
 }

@@ -302,11 +302,5 @@ fn a_lane_resets_and_trips_alone() {
 /// MIXED writes every law of the table, so that each runs in lanes against the plain engine.
 #[test]
 fn the_mixed_model_writes_every_law() {
-    for kind in ressort_engine::LawKind::ALL {
-        let keyword = kind.row().keyword;
-        assert!(
-            MIXED.contains(&format!(" {keyword} ")),
-            "MIXED has no {keyword}"
-        );
-    }
+    common::assert_writes_every_law(MIXED);
 }

@@ -204,8 +204,7 @@ fn law_in_lanes<S: Simd, L: Law>(
 mod tests {
     use super::*;
     use crate::lanes::LANES;
-    use crate::laws::picks::{check, draws, Draw, EveryOperation};
-    use crate::laws::LawVisitor;
+    use crate::laws::picks::{check, check_every_law, draws, Draw, Path};
 
     /// Runs a law on one [`Lanes`] of draws.
     struct Run<'a, L> {
@@ -223,36 +222,28 @@ mod tests {
         }
     }
 
-    /// `L` on the CPU's instruction set and on pulp's scalar one, against `L` on `f64`.
-    fn check_law<L: Law>(name: &str) {
-        let draws = draws(LANES * 4000);
-        let (mut native, mut scalar) = (Vec::new(), Vec::new());
-        for chunk in draws.chunks_exact(LANES) {
-            let run = || Run::<L> {
-                draws: chunk,
-                law: PhantomData,
-            };
-            native.extend(pulp::Arch::new().dispatch(run()).0);
-            scalar.extend(pulp::Scalar::new().vectorize(run()).0);
-        }
-        check::<L>(name, "lanes (this CPU)", &draws, &native);
-        check::<L>(name, "lanes (scalar)", &draws, &scalar);
-    }
+    /// Every law on the CPU's instruction set and on pulp's scalar one, against `f64`.
+    struct InLanes;
 
-    struct Check(usize);
-
-    impl LawVisitor for Check {
-        fn visit<L: Law>(&mut self, kind: LawKind) {
-            check_law::<L>(&format!("{kind:?}"));
-            self.0 += 1;
+    impl Path for InLanes {
+        fn check_law<L: Law>(&mut self, name: &str) {
+            let draws = draws(LANES * 4000);
+            let (mut native, mut scalar) = (Vec::new(), Vec::new());
+            for chunk in draws.chunks_exact(LANES) {
+                let run = || Run::<L> {
+                    draws: chunk,
+                    law: PhantomData,
+                };
+                native.extend(pulp::Arch::new().dispatch(run()).0);
+                scalar.extend(pulp::Scalar::new().vectorize(run()).0);
+            }
+            check::<L>(name, "lanes (this CPU)", &draws, &native);
+            check::<L>(name, "lanes (scalar)", &draws, &scalar);
         }
     }
 
     #[test]
     fn every_law_in_lanes_equals_the_law_on_f64() {
-        let mut visited = Check(0);
-        LawKind::visit_all(&mut visited);
-        assert_eq!(visited.0, LawKind::COUNT);
-        check_law::<EveryOperation>("every operation");
+        check_every_law(&mut InLanes);
     }
 }

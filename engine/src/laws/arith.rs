@@ -190,7 +190,7 @@ impl Arith for Scalar {
 pub(crate) mod picks {
     use super::{Arith, Scalar};
     use crate::laws::linear::Linear;
-    use crate::laws::{Law, LawKind, LawRow};
+    use crate::laws::{Law, LawKind, LawRow, LawVisitor};
 
     /// Both signs, zeros, tiny and huge, infinities, NaN.
     const VALUES: [f64; 16] = [
@@ -287,6 +287,27 @@ pub(crate) mod picks {
             mismatches, 0,
             "{name} on {path} differs from its law on f64"
         );
+    }
+
+    /// A path of the engine that the differential test runs laws on.
+    pub(crate) trait Path {
+        /// Runs `L` on this path over [`draws`] and [`check`]s it.
+        fn check_law<L: Law>(&mut self, name: &str);
+    }
+
+    /// Runs `path` on every law of the table, then on [`EveryOperation`].
+    pub(crate) fn check_every_law(path: &mut impl Path) {
+        struct Visit<'a, P>(&'a mut P, usize);
+        impl<P: Path> LawVisitor for Visit<'_, P> {
+            fn visit<L: Law>(&mut self, kind: LawKind) {
+                self.0.check_law::<L>(&format!("{kind:?}"));
+                self.1 += 1;
+            }
+        }
+        let mut visit = Visit(path, 0);
+        LawKind::visit_all(&mut visit);
+        assert_eq!(visit.1, LawKind::COUNT);
+        path.check_law::<EveryOperation>("every operation");
     }
 
     /// A formula that uses every operation of [`Arith`], checked like a law on every path,

@@ -112,3 +112,15 @@ pub fn hash_f64s<'a>(values: impl IntoIterator<Item = &'a f64>) -> u64 {
     }
     h
 }
+
+/// Panics unless `text` writes every law of the table (its keyword between spaces), so that a
+/// differential test over `text` runs a law as soon as it is added.
+pub fn assert_writes_every_law(text: &str) {
+    for kind in ressort_engine::LawKind::ALL {
+        let keyword = kind.row().keyword;
+        assert!(
+            text.contains(&format!(" {keyword} ")),
+            "the model has no {keyword}"
+        );
+    }
+}
