@@ -1,6 +1,8 @@
 //! What a voice of a preset costs in heap memory, at 48 kHz: the bytes a prepared model holds
-//! with one voice, and what each further voice of its bank adds (the difference between 9
-//! voices and 1, over 8), counted by a global allocator that tracks live bytes:
+//! with one voice, what each further voice of its bank adds (the difference between 9 voices
+//! and 1, over 8: a bank keeps a quarter more copies than voices, for the voices it steals),
+//! and what one more copy of the compiled engine costs (its state: the compiled model is
+//! shared), counted by a global allocator that tracks live bytes:
 //! `cargo run --release -p ressort-engine --example voice_memory -- string-1000 chladni-150x150`
 //! (names of scripts in `models/`, run from the workspace root).
 use ressort_engine::instrument::prepare;
@@ -53,10 +55,15 @@ fn main() {
         model.set_voices(9);
         let nine = LIVE.load(Ordering::Relaxed) - before;
         let per_voice = nine.saturating_sub(one) / 8;
+        let before_copy = LIVE.load(Ordering::Relaxed);
+        let copy = model.engine.clone();
+        let engine_copy = LIVE.load(Ordering::Relaxed) - before_copy;
+        drop(copy);
         println!(
-            "{name:<24} prepared, 1 voice {:8.2} MiB   each further voice {:8.3} MiB ({per_voice} bytes)",
+            "{name:<24} prepared, 1 voice {:8.2} MiB   each further voice {:8.3} MiB ({per_voice} bytes)   one engine copy {:8.3} MiB",
             mib(one),
-            mib(per_voice)
+            mib(per_voice),
+            mib(engine_copy)
         );
         drop(model);
     }

@@ -27,7 +27,7 @@ impl Engine {
     /// point, the node with the largest weight for a connection point (spec §2.8).
     fn display_point(&self, index: u32) -> Option<u32> {
         let i = index as usize;
-        if i < self.info.num_points {
+        if i < self.model.info.num_points {
             return Some(index);
         }
         let p = i.checked_sub(self.proxies.base)?;
@@ -50,17 +50,18 @@ impl Engine {
                 });
             }
         };
-        for r in &self.force_inputs {
+        for r in &self.model.force_inputs {
             push(IoKind::ForceInput, r.channel, r.index);
         }
-        for r in &self.avatars {
+        for r in &self.model.avatars {
             push(IoKind::PositionInput, r.channel, r.index);
         }
-        for r in &self.pos_outputs {
+        for r in &self.model.pos_outputs {
             push(IoKind::PositionOutput, r.channel, r.index);
         }
-        for &(channel, start, len) in &self.frc_outputs {
+        for &(channel, start, len) in &self.model.frc_outputs {
             if let Some(&first) = self
+                .model
                 .frc_sources
                 .get(start as usize..(start + len) as usize)
                 .and_then(|s| s.first())

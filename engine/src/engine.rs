@@ -17,12 +17,12 @@
 //! its own stencil kernel. Each interaction law has its own loop over endpoint index arrays.
 //! Names never reach this module's hot paths; there is no per-element `match`.
 
+pub(crate) use crate::compiled::Compiled;
 use crate::control::{Changed, ControlArgs};
 pub use crate::display::{IoKind, IoPoint};
-use crate::expr::{ExprRef, Program};
+use crate::expr::ExprRef;
 pub use crate::guard::{GuardEvent, GuardKind};
 use crate::info::ModelInfo;
-use crate::jit::NativeCode;
 pub(crate) use crate::kernels::masses::{single_law, SingleMasses};
 use crate::motion::MotionStore;
 pub(crate) use crate::rest::Rest;
@@ -123,12 +123,22 @@ pub const FLUSH_BELOW: f64 = 1.0e-150;
 /// is flushed.
 pub const FLUSH_INTERVAL: u64 = 64;
 
-/// A compiled model and its running state. Built by [`crate::compile`].
+/// A compiled model and one running copy of it: the immutable model ([`Compiled`], shared by
+/// every copy behind an `Arc`) and this copy's state. Built by [`crate::compile`]. A clone is a
+/// new voice: it copies the state and shares the model.
+///
+/// 3,712 bytes on x86-64 (checked below; 2,376 of them are the vector headers of the nine
+/// law groups), and on the heap: 24 bytes per point (x, x̃, F), 8 per link of the longest
+/// chain, 8 per argument slot, 47 per single mass (a, b, 1/M, g, three flags and a run), 16
+/// per node of the largest macro (its scratch), 12 per link (endpoints and element) and 2 per
+/// chain of the law groups.
 #[derive(Clone, Debug)]
 pub struct Engine {
-    pub(crate) info: ModelInfo,
+    /// Structure, routes, expressions, labels and native code: never written after
+    /// compilation.
+    pub(crate) model: Arc<Compiled>,
 
-    // Hot state.
+    // Hot state, read or written at every sample.
     pub(crate) points: Points,
     /// Per-step argument values (after scaling and class gains), column by column.
     pub(crate) args: Vec<f64>,
@@ -136,53 +146,26 @@ pub struct Engine {
     pub(crate) macros: Macros,
     pub(crate) proxies: Proxies,
     pub(crate) interactions: Interactions,
-    /// Avatars: input channel → point (stage 1 a).
-    pub(crate) avatars: Vec<Route>,
-    /// Audio-rate parameters: input channel → parameter slot (stage 1 b).
-    pub(crate) audio_params: Vec<Route>,
-    /// The declared default of each entry of `audio_params`, added to its input.
-    pub(crate) audio_defaults: Vec<f64>,
-    /// Force inputs: input channel → point (stage 4).
-    pub(crate) force_inputs: Vec<Route>,
-    /// `posOutput`: output channel ← point.
-    pub(crate) pos_outputs: Vec<Route>,
-    /// `frcOutput`: output channel ← the sum of F over `frc_sources[start..start+len]`, packed
-    /// as (channel, start, len). A plain target has one source; a connection point reads every
-    /// connection point at the same location (spec §3.12 e, see `compile`).
-    pub(crate) frc_outputs: Vec<(u32, u32, u32)>,
-    pub(crate) frc_sources: Vec<u32>,
-
-    // Parameters.
-    pub(crate) program: Program,
-    pub(crate) stack: crate::expr::EvalStack,
     /// Current parameter values, by parameter id.
     pub(crate) params: Vec<f64>,
+    /// The declared default of each entry of `model.audio_params`, added to its input; set by
+    /// [`Engine::set_param`].
+    pub(crate) audio_defaults: Vec<f64>,
+    pub(crate) stack: crate::expr::EvalStack,
+
+    // Controls: written at a block boundary after a change.
     /// Arguments that depend on no audio-rate parameter: brought up to date at a block
     /// boundary after a control parameter or a class gain changed.
     pub(crate) control: ControlArgs,
-    /// Arguments that depend on an audio-rate parameter: re-evaluated every sample.
-    pub(crate) audio_bindings: Vec<Binding>,
-    /// Single masses and proxies whose coefficients depend on audio-rate arguments.
-    pub(crate) audio_masses: Vec<u32>,
-    pub(crate) audio_proxies: Vec<u32>,
-    /// Scale factor of each [`ArgClass`] at this sample rate (spec §1.7).
-    pub(crate) class_scale: [f64; NUM_ARG_CLASSES],
     /// Host gain of each class (1 unless the host changes it).
     pub(crate) class_gain: [f64; NUM_ARG_CLASSES],
     pub(crate) params_dirty: bool,
-
-    // Initial state.
-    pub(crate) init_runs: Vec<InitRun>,
-    /// Local indices of fixed nodes per macro, applied after `init_runs`: (first point, count
-    /// of points in the run, indices), flattened as point indices.
-    pub(crate) init_fixed_points: Vec<u32>,
 
     // Guard and motion.
     pub(crate) position_limit: f64,
     pub(crate) guard: Option<GuardEvent>,
     pub(crate) samples_since_reset: u64,
     pub(crate) motion: Option<Arc<MotionStore>>,
-    pub(crate) motion_interval: u32,
     pub(crate) motion_counter: u32,
     /// Whether the state is known to be a fixed point of the sample loop ([`Rest`]).
     pub(crate) rest: Rest,
@@ -191,11 +174,8 @@ pub struct Engine {
     /// picks the best the CPU has. Without FMA contraction all give the same IEEE operations,
     /// so the same samples.
     pub(crate) arch: pulp::Arch,
-    /// The sample loop compiled to machine code, for small models ([`crate::jit`]); shared
-    /// by the engine's copies.
-    pub(crate) native: Option<Arc<NativeCode>>,
-    /// Whether `native` runs the model as it stands ([`NativeCode::fits`]): updated with the
-    /// coefficients at every control change.
+    /// Whether `model.native` runs the model as it stands ([`crate::jit::NativeCode::fits`]): updated
+    /// with the coefficients at every control change.
     pub(crate) native_fits: bool,
 }
 
@@ -272,17 +252,18 @@ pub struct BlockReport {
 impl Engine {
     /// The model's metadata: counts, labels, parameters, channels, motion layout.
     pub fn info(&self) -> &ModelInfo {
-        &self.info
+        &self.model.info
     }
 
     /// The sample rate the model was compiled for, in Hz.
     pub fn sample_rate_hz(&self) -> f64 {
-        self.info.sample_rate_hz
+        self.model.info.sample_rate_hz
     }
 
     /// Looks up a parameter by name (off the audio thread: it compares strings).
     pub fn param_id(&self, name: &str) -> Option<ParamId> {
-        self.info
+        self.model
+            .info
             .params
             .iter()
             .position(|p| p.name == name)
@@ -308,7 +289,7 @@ impl Engine {
         if !value.is_finite() {
             return Err(ParamError::NonFinite(value));
         }
-        if let Some(r) = self.audio_params.iter().position(|r| r.index == id.0) {
+        if let Some(r) = self.model.audio_params.iter().position(|r| r.index == id.0) {
             // The default is read at every sample (stage 1 b), so it acts from the first
             // sample of the next block. The value itself becomes the default until then, so
             // the stability analysis and a reset see the new centre.
@@ -384,7 +365,7 @@ impl Engine {
 
     /// The motion refresh interval R, in samples.
     pub fn motion_interval(&self) -> u32 {
-        self.motion_interval
+        self.model.motion_interval
     }
 
     /// Current positions of every point: the material points of [`ModelInfo::points`], then
@@ -413,22 +394,25 @@ impl Engine {
         self.refresh_control();
         self.points.f.fill(0.0);
         self.macros.reset();
-        for run in &self.init_runs {
-            let x0 = self.program.eval(run.x0, &self.params, &mut self.stack);
+        for run in &self.model.init_runs {
+            let x0 = self
+                .model
+                .program
+                .eval(run.x0, &self.params, &mut self.stack);
             let xp = match run.rule {
                 InitRule::Fixed => x0,
                 InitRule::Velocity { v, factor } => {
-                    x0 - self.program.eval(v, &self.params, &mut self.stack) * factor
+                    x0 - self.model.program.eval(v, &self.params, &mut self.stack) * factor
                 }
                 InitRule::Delayed { xr0, factor } => {
-                    x0 - (x0 - self.program.eval(xr0, &self.params, &mut self.stack)) * factor
+                    x0 - (x0 - self.model.program.eval(xr0, &self.params, &mut self.stack)) * factor
                 }
             };
             let range = run.first as usize..(run.first + run.count) as usize;
             self.points.x[range.clone()].fill(x0);
             self.points.xp[range].fill(xp);
         }
-        for &p in &self.init_fixed_points {
+        for &p in &self.model.init_fixed_points {
             self.points.xp[p as usize] = self.points.x[p as usize];
         }
         // Connection points start at their interpolated position with no velocity.
@@ -451,8 +435,11 @@ impl Engine {
     pub(crate) fn rest_positions(&mut self) -> Vec<f64> {
         self.apply_pending_changes();
         let mut x = vec![0.0; self.points.x.len()];
-        for run in &self.init_runs {
-            let x0 = self.program.eval(run.x0, &self.params, &mut self.stack);
+        for run in &self.model.init_runs {
+            let x0 = self
+                .model
+                .program
+                .eval(run.x0, &self.params, &mut self.stack);
             x[run.first as usize..(run.first + run.count) as usize].fill(x0);
         }
         for i in 0..self.proxies.len() {
@@ -473,7 +460,7 @@ impl Engine {
     fn refresh_control(&mut self) {
         let scale = self.class_factors();
         let changed = self.control.refresh(
-            &self.program,
+            &self.model.program,
             &self.params,
             &mut self.stack,
             &scale,
@@ -498,11 +485,11 @@ impl Engine {
                     self.singles.classify();
                 }
                 // Audio-rate arguments follow the class factors too.
-                for &i in &self.audio_masses {
+                for &i in &self.model.audio_masses {
                     self.singles.derive(i as usize, &self.args);
                 }
                 for i in 0..self.proxies.len() {
-                    if proxies || self.audio_proxies.contains(&(i as u32)) {
+                    if proxies || self.model.audio_proxies.contains(&(i as u32)) {
                         self.proxies.derive(i, &self.args);
                     }
                 }
@@ -513,7 +500,11 @@ impl Engine {
         if matches!(changed, Changed::All | Changed::Some { values: true, .. }) {
             self.interactions.find_uniform(self.control.raw());
         }
-        self.native_fits = self.native.as_ref().is_some_and(|code| code.fits(self));
+        self.native_fits = self
+            .model
+            .native
+            .as_ref()
+            .is_some_and(|code| code.fits(self));
         // New coefficients end a fixed point (`rest.rs`), whichever call applied them.
         self.rest = Rest::Moving;
         self.params_dirty = false;
@@ -521,7 +512,7 @@ impl Engine {
 
     #[inline]
     fn class_factors(&self) -> [f64; NUM_ARG_CLASSES] {
-        let mut f = self.class_scale;
+        let mut f = self.model.class_scale;
         for (f, g) in f.iter_mut().zip(self.class_gain) {
             *f *= g;
         }
@@ -531,9 +522,12 @@ impl Engine {
     /// Evaluates the audio-rate arguments (stage 1 b consequences).
     #[inline]
     fn refresh_audio_args(&mut self, scale: &[f64; NUM_ARG_CLASSES]) {
-        for b in &self.audio_bindings {
+        for b in &self.model.audio_bindings {
             self.args[b.slot as usize] =
-                self.program.eval(b.expr, &self.params, &mut self.stack) * scale[b.class as usize];
+                self.model
+                    .program
+                    .eval(b.expr, &self.params, &mut self.stack)
+                    * scale[b.class as usize];
         }
     }
 
@@ -643,7 +637,7 @@ impl Engine {
             let until_write = match (watched, self.motion_counter) {
                 (false, _) => frames_end,
                 (true, 0) => 0,
-                (true, c) => (self.motion_interval - c) as usize,
+                (true, c) => (self.model.motion_interval - c) as usize,
             };
             let end = frames_end.min(n + until_write);
             for k in n..end {
@@ -653,7 +647,8 @@ impl Engine {
             }
             if watched {
                 self.motion_counter = ((self.motion_counter as usize + (end - n))
-                    % self.motion_interval as usize) as u32;
+                    % self.model.motion_interval as usize)
+                    as u32;
             }
             n = end;
             if n < frames_end && watched {
@@ -661,7 +656,7 @@ impl Engine {
                 if self.sample::<true>(n, &io, outputs, &scale) {
                     return n + 1;
                 }
-                self.motion_counter = 1 % self.motion_interval;
+                self.motion_counter = 1 % self.model.motion_interval;
                 n += 1;
             }
         }
@@ -695,7 +690,7 @@ impl Engine {
         // Stage 7: motion buffers, on the first sample and then every R samples.
         if MOTION {
             if let Some(store) = &self.motion {
-                store.write(&self.points.x[..self.info.num_points]);
+                store.write(&self.points.x[..self.model.info.num_points]);
             }
         }
         if self.outputs_or_trip(n, io.frames, io.out_channels, outputs) {
@@ -713,24 +708,24 @@ impl Engine {
     #[inline(always)]
     fn step(&mut self, input: &impl Fn(u32) -> f64, scale: &[f64; NUM_ARG_CLASSES]) {
         // Stage 1 a: avatars.
-        for r in &self.avatars {
+        for r in &self.model.avatars {
             let k = r.index as usize;
             self.points.xp[k] = self.points.x[k];
             self.points.x[k] = input(r.channel);
             self.points.f[k] = 0.0;
         }
         // Stage 1 b: audio-rate parameters, and the arguments and coefficients that use them.
-        if !self.audio_params.is_empty() {
+        if !self.model.audio_params.is_empty() {
             // Default + signal (`ParamKind::Audio`): spec §1.5 stage 1 b with the default of
             // this project's `audioParam @inN default`; 0 gives the spec's in_N(n) exactly.
-            for (r, d) in self.audio_params.iter().zip(&self.audio_defaults) {
+            for (r, d) in self.model.audio_params.iter().zip(&self.audio_defaults) {
                 self.params[r.index as usize] = d + input(r.channel);
             }
             self.refresh_audio_args(scale);
-            for &i in &self.audio_masses {
+            for &i in &self.model.audio_masses {
                 self.singles.derive(i as usize, &self.args);
             }
-            for &i in &self.audio_proxies {
+            for &i in &self.model.audio_proxies {
                 self.proxies.derive(i as usize, &self.args);
             }
         }
@@ -743,7 +738,7 @@ impl Engine {
         self.proxies.update_positions(&mut self.points);
         // Stage 4: interactions, then force inputs.
         self.interactions.step(&mut self.points, &self.args);
-        for r in &self.force_inputs {
+        for r in &self.model.force_inputs {
             self.points.f[r.index as usize] += input(r.channel);
         }
         // Stage 5: connection-point force spreading.
@@ -795,11 +790,11 @@ impl Engine {
                 }
             }
         };
-        for r in &self.pos_outputs {
+        for r in &self.model.pos_outputs {
             put(r.channel, self.points.x[r.index as usize]);
         }
-        for &(channel, start, len) in &self.frc_outputs {
-            let sources = &self.frc_sources[start as usize..(start + len) as usize];
+        for &(channel, start, len) in &self.model.frc_outputs {
+            let sources = &self.model.frc_sources[start as usize..(start + len) as usize];
             let total = sources.iter().map(|&p| self.points.f[p as usize]).sum();
             put(channel, total);
         }
@@ -826,3 +821,7 @@ impl Engine {
         }
     }
 }
+
+/// The size written in [`Engine`]'s doc comment.
+#[cfg(target_arch = "x86_64")]
+const _: () = assert!(std::mem::size_of::<Engine>() == 3712);

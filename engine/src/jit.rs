@@ -54,7 +54,7 @@ mod sample;
 /// the state no longer fits in registers and the interpreter's vector loops win: on the Zen 3
 /// build machine, element-by-element strings of 22, 32 and 48 masses (45, 65 and 97 points
 /// and links) ran 1.3×, 0.9× and 0.8× as fast on native code as on the interpreter, meshes
-/// of 5 × 5 and 6 × 6 nodes (65 and 96) 1.4× and 0.6× (docs/NOTES.md).
+/// of 5 × 5 and 6 × 6 nodes (65 and 96) 1.4× and 0.6× (docs/design/simulation.md, "Native code for small models").
 pub(crate) const MAX_ELEMENTS: usize = 60;
 
 /// What the generated function reads: the engine's arrays and the block's buffers.
@@ -199,7 +199,8 @@ impl Engine {
     /// `engine/src/jit.rs`) rather than on the interpreter. Parameter changes are counted from
     /// the next block (or [`Engine::apply_pending_changes`]).
     pub fn native_code_bytes(&self) -> Option<usize> {
-        self.native
+        self.model
+            .native
             .as_ref()
             .filter(|_| self.native_fits)
             .map(|code| code.size())
@@ -212,7 +213,7 @@ impl Engine {
         emit::fits(self)
     }
 
-    /// Samples `start..end` of a block on the native code (`self.native`, which `fits`):
+    /// Samples `start..end` of a block on the native code (`self.model.native`, which `fits`):
     /// what [`Engine::run`] does on the interpreter, with the same samples. Returns how many
     /// samples ran (fewer when the guard trips).
     pub(crate) fn run_native(
@@ -227,7 +228,7 @@ impl Engine {
             in_channels,
             out_channels,
         } = io;
-        let Some(entry) = self.native.as_ref().map(|code| code.entry) else {
+        let Some(entry) = self.model.native.as_ref().map(|code| code.entry) else {
             return 0;
         };
         // The native code reads and writes these buffers by raw pointer: checked on every call

@@ -120,8 +120,8 @@ impl LaneEngine {
     /// Whether a model runs in lanes: no audio-rate parameters (they re-derive arguments
     /// every sample), and at most [`MAX_LANE_POINTS`] points.
     pub fn supports(engine: &Engine) -> bool {
-        engine.audio_params.is_empty()
-            && engine.audio_bindings.is_empty()
+        engine.model.audio_params.is_empty()
+            && engine.model.audio_bindings.is_empty()
             && engine.points.x.len() <= MAX_LANE_POINTS
     }
 
@@ -313,7 +313,8 @@ impl LaneEngine {
         let full = self.params_dirty;
         if full {
             for bind in &t.control.bindings {
-                self.raw[bind.slot as usize] = t.program.eval(bind.expr, &t.params, &mut t.stack);
+                self.raw[bind.slot as usize] =
+                    t.model.program.eval(bind.expr, &t.params, &mut t.stack);
             }
             self.gains_dirty = [true; LANES];
             self.params_dirty = false;
@@ -326,7 +327,7 @@ impl LaneEngine {
                 continue;
             }
             // The factors as `Engine::class_factors` forms them: scale × gain.
-            let mut scale = t.class_scale;
+            let mut scale = t.model.class_scale;
             for (s, g) in scale.iter_mut().zip(self.gains[l]) {
                 *s *= g;
             }
@@ -497,7 +498,7 @@ impl LaneEngine {
             }
         };
         // Stage 1 a: avatars.
-        for r in &self.template.avatars {
+        for r in &self.template.model.avatars {
             let k = r.index as usize;
             for l in 0..LANES {
                 self.xp[k][l] = self.x[k][l];
@@ -558,7 +559,7 @@ impl LaneEngine {
             xp,
             f,
         });
-        for r in &self.template.force_inputs {
+        for r in &self.template.model.force_inputs {
             // A silent or missing channel adds 0, as the plain engine does (−0 + 0 = +0).
             let fi = &mut f[r.index as usize];
             for (l, v) in fi.iter_mut().enumerate() {
@@ -592,13 +593,13 @@ impl LaneEngine {
             }
         };
         let mut beyond = Lanes::ZERO;
-        for r in &t.pos_outputs {
+        for r in &t.model.pos_outputs {
             let v = self.x[r.index as usize];
             beyond = o.flag_beyond(v, limit, beyond);
             put(r.channel, &v);
         }
-        for &(channel, start, len) in &t.frc_outputs {
-            let sources = &t.frc_sources[start as usize..(start + len) as usize];
+        for &(channel, start, len) in &t.model.frc_outputs {
+            let sources = &t.model.frc_sources[start as usize..(start + len) as usize];
             // Σ F as `Iterator::sum` forms it: −0 + F₁ = F₁ bit for bit, then in order.
             let mut total = Lanes::splat(-0.0);
             for &p in sources {

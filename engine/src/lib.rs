@@ -22,6 +22,7 @@
 //! ```
 
 pub mod compile;
+mod compiled;
 mod control;
 mod display;
 pub mod engine;

@@ -92,7 +92,7 @@ pub(crate) fn kind_moves(kind: PointKind) -> bool {
 /// or the macro nodes of a connection point with their interpolation weights (spec §2.8).
 pub(crate) fn endpoint_nodes(e: &Engine, p: u32) -> impl Iterator<Item = (usize, f64)> + '_ {
     let p = p as usize;
-    let n = e.info.num_points;
+    let n = e.model.info.num_points;
     let proxy = p
         .checked_sub(e.proxies.base)
         .filter(|&i| p >= n && i < e.proxies.len());
@@ -111,7 +111,7 @@ pub(crate) fn endpoint_nodes(e: &Engine, p: u32) -> impl Iterator<Item = (usize,
 impl Network {
     /// Walks the compiled model once (spec §5.2 and §5.5).
     pub(crate) fn walk(e: &Engine, valuation: Valuation<'_>) -> Network {
-        let info = &e.info;
+        let info = &e.model.info;
         let n = info.num_points;
         let args = &e.args;
         let mut net = Network {

@@ -132,8 +132,8 @@ mod tests {
             let spec = parse(text).spec.expect("parses");
             let engine = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
             let (mut held, mut stepped) = (engine.clone(), engine);
-            let ins = held.info.inputs.len().max(1);
-            let outs = held.info.outputs.len();
+            let ins = held.model.info.inputs.len().max(1);
+            let outs = held.model.info.outputs.len();
             let (mut held_blocks, mut trips) = (0, 0);
             let mut lcg = 7u64;
             for block in 0..900 {

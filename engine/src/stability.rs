@@ -212,7 +212,7 @@ fn stiff_string_lambda(k: f64, ks: f64) -> f64 {
 }
 
 fn analyze(e: &Engine, labelled: bool) -> StabilityReport {
-    let info = &e.info;
+    let info = &e.model.info;
     let n = info.num_points;
     let args = &e.args;
     // The network with every nonlinear law at its bounded tangent (crate::network).

@@ -4,7 +4,7 @@
 //! The Voices parameter only stores its value ([`ModelStore::set_voices`]); re-preparing the
 //! model allocates, so it must happen off the audio thread. CLAP hosts run a main-thread task
 //! that `process()` queues. nice-plug 0.4.2 runs such tasks in VST3 and the standalone on its
-//! shared background worker, which aborts the host once an instance is gone (docs/NOTES.md,
+//! shared background worker, which aborts the host once an instance is gone (docs/design/plugin.md,
 //! "Guard reporting"), so there a small thread of the instance's own looks for a stale setting
 //! a few times a second and re-prepares the model. The audio thread never talks to it.
 

@@ -10,10 +10,11 @@ use super::labels::Params;
 use super::points::Numbering;
 use super::{CompileOptions, Rate};
 use crate::control::ControlArgs;
-use crate::engine::{ArgClass, Engine, Points, DEFAULT_POSITION_LIMIT, NUM_ARG_CLASSES};
+use crate::engine::{ArgClass, Compiled, Engine, Points, DEFAULT_POSITION_LIMIT, NUM_ARG_CLASSES};
 use crate::info::{ModelInfo, ParamInfo};
 use crate::motion::{MotionLayout, NamedBuffer};
 use crate::spec::{Element, ElementKind, SampleRateMode, ScaleClass, Vector};
+use std::sync::Arc;
 
 impl<'a> Cx<'a> {
     /// Builds the engine, or returns every error the passes found.
@@ -96,8 +97,26 @@ impl<'a> Cx<'a> {
         let mut macros = bound.macros;
         macros.scratch_ext = vec![(0, 0.0); 4 * num_proxies];
         let arch = crate::kernels::arch_for(&macros);
-        let mut engine = Engine {
+        let model = Compiled {
             info,
+            program: self.program,
+            avatars: avatars.into_iter().map(|(_, route)| route).collect(),
+            audio_params: params.audio,
+            force_inputs: io.force_inputs,
+            pos_outputs: io.pos_outputs,
+            frc_outputs: io.frc_outputs,
+            frc_sources: io.frc_sources,
+            audio_bindings: self.audio_bindings,
+            audio_masses: bound.audio_masses,
+            audio_proxies: self.proxy_audio,
+            class_scale: class_scales(rate.mode, rate.sr),
+            init_runs: bound.init_runs,
+            init_fixed_points: numbering.fixed_points,
+            motion_interval: options.motion_interval.max(1),
+            native: None,
+        };
+        let mut engine = Engine {
+            model: Arc::new(model),
             points: Points {
                 x: vec![0.0; total],
                 xp: vec![0.0; total],
@@ -109,40 +128,30 @@ impl<'a> Cx<'a> {
             macros,
             proxies,
             interactions,
-            avatars: avatars.into_iter().map(|(_, route)| route).collect(),
-            audio_params: params.audio,
-            audio_defaults,
-            force_inputs: io.force_inputs,
-            pos_outputs: io.pos_outputs,
-            frc_outputs: io.frc_outputs,
-            frc_sources: io.frc_sources,
-            program: self.program,
-            stack,
             params: params.values,
+            audio_defaults,
+            stack,
             control,
-            audio_bindings: self.audio_bindings,
-            audio_masses: bound.audio_masses,
-            audio_proxies: self.proxy_audio,
-            class_scale: class_scales(rate.mode, rate.sr),
             class_gain: [1.0; NUM_ARG_CLASSES],
             params_dirty: true,
-            rest: Default::default(),
-            init_runs: bound.init_runs,
-            init_fixed_points: numbering.fixed_points,
             position_limit: DEFAULT_POSITION_LIMIT,
             guard: None,
             samples_since_reset: 0,
             motion: None,
-            motion_interval: options.motion_interval.max(1),
             motion_counter: 0,
+            rest: Default::default(),
             arch,
-            native: None,
             native_fits: false,
         };
         engine.reset();
         if options.jit {
-            engine.native = crate::jit::NativeCode::build(&engine).map(std::sync::Arc::new);
+            let native = crate::jit::NativeCode::build(&engine);
+            // The only reference: the model is shared from the first clone on.
+            if let Some(model) = Arc::get_mut(&mut engine.model) {
+                model.native = native;
+            }
             engine.native_fits = engine
+                .model
                 .native
                 .as_ref()
                 .is_some_and(|code| code.fits(&engine));

@@ -49,21 +49,23 @@ pub(super) fn fits(engine: &Engine) -> bool {
         && m.stiff.is_empty()
         && m.meshes.is_empty()
         && engine.proxies.len() == 0
-        && engine.audio_params.is_empty()
-        && engine.audio_bindings.is_empty()
+        && engine.model.audio_params.is_empty()
+        && engine.model.audio_bindings.is_empty()
         && n + links <= MAX_ELEMENTS
-        && n == engine.singles.len() + engine.avatars.len()
+        && n == engine.singles.len() + engine.model.avatars.len()
         && engine
+            .model
             .avatars
             .iter()
             .all(|r| r.index as usize >= engine.singles.len() && inside(r.index))
-        && engine.force_inputs.iter().all(|r| inside(r.index))
-        && engine.pos_outputs.iter().all(|r| inside(r.index))
-        && engine.frc_sources.iter().all(|&p| inside(p))
+        && engine.model.force_inputs.iter().all(|r| inside(r.index))
+        && engine.model.pos_outputs.iter().all(|r| inside(r.index))
+        && engine.model.frc_sources.iter().all(|&p| inside(p))
         && engine
+            .model
             .frc_outputs
             .iter()
-            .all(|&(_, start, len)| (start + len) as usize <= engine.frc_sources.len())
+            .all(|&(_, start, len)| (start + len) as usize <= engine.model.frc_sources.len())
         && groups(engine).all(|(law, g)| {
             g.cols.len() == law.arity()
                 && g.a.iter().chain(&g.b).all(|&p| inside(p))
@@ -144,7 +146,7 @@ fn unit_mass(e: &Engine, i: usize) -> bool {
             .bindings
             .iter()
             .filter(|b| b.slot as usize == slot)
-            .all(|b| e.program.params_read(b.expr).next().is_none())
+            .all(|b| e.model.program.params_read(b.expr).next().is_none())
 }
 
 /// The state of every point as variables of the function being built.
@@ -256,13 +258,19 @@ impl<'a, 'b> Emitter<'a, 'b> {
             self.field(offset_of!(Frame, gravity)),
         ];
         let args = self.field(offset_of!(Frame, args));
-        let input_numbers =
-            sorted_unique(e.avatars.iter().chain(&e.force_inputs).map(|r| r.channel));
+        let input_numbers = sorted_unique(
+            e.model
+                .avatars
+                .iter()
+                .chain(&e.model.force_inputs)
+                .map(|r| r.channel),
+        );
         let output_numbers = sorted_unique(
-            e.pos_outputs
+            e.model
+                .pos_outputs
                 .iter()
                 .map(|r| r.channel)
-                .chain(e.frc_outputs.iter().map(|o| o.0)),
+                .chain(e.model.frc_outputs.iter().map(|o| o.0)),
         );
         let inputs = self.channels(&input_numbers, start, true);
         let outputs = self.channels(&output_numbers, start, false);

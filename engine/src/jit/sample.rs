@@ -58,7 +58,7 @@ impl Emitter<'_, '_> {
         let input = |ch: u32| read.iter().find(|r| r.0 == ch).map_or(zero, |r| r.1);
 
         // Stage 1 a: avatars take their input; their force is cleared.
-        for r in &e.avatars {
+        for r in &e.model.avatars {
             let p = r.index as usize;
             let old = self.b.use_var(self.state.x[p]);
             self.b.def_var(self.state.xp[p], old);
@@ -68,7 +68,7 @@ impl Emitter<'_, '_> {
         self.masses(setup, zero);
         let mut touched = self.links(setup);
         // F + in is F when in is +0 (F is never −0), which a silent input usually is.
-        for r in &e.force_inputs {
+        for r in &e.model.force_inputs {
             let p = r.index as usize;
             let v = input(r.channel);
             let f = self.b.use_var(self.state.f[p]);
@@ -238,12 +238,12 @@ impl Emitter<'_, '_> {
     fn outputs(&mut self, k: Value, offset: Value, setup: &Setup, bad: Block) {
         let e = self.e;
         let mut values = Vec::new();
-        for r in &e.pos_outputs {
+        for r in &e.model.pos_outputs {
             values.push((r.channel, self.b.use_var(self.state.x[r.index as usize])));
         }
-        for &(channel, start, len) in &e.frc_outputs {
+        for &(channel, start, len) in &e.model.frc_outputs {
             let mut total = self.constant(-0.0);
-            for &p in &e.frc_sources[start as usize..(start + len) as usize] {
+            for &p in &e.model.frc_sources[start as usize..(start + len) as usize] {
                 let f = self.b.use_var(self.state.f[p as usize]);
                 total = self.b.ins().fadd(total, f);
             }

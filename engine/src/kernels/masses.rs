@@ -201,3 +201,7 @@ fn run<const CLEAR: bool>(
         }
     }
 }
+
+/// The size of a run entry that [`Engine`](crate::Engine)'s doc comment counts.
+#[cfg(target_arch = "x86_64")]
+const _: () = assert!(std::mem::size_of::<(u32, u32, Update, bool)>() == 12);

@@ -4,7 +4,7 @@
 //!
 //! Why not plain loops over the lanes: with eight lanes, LLVM vectorises the loop over points
 //! instead of the lanes, with gathers and scatters at a 64-byte stride, several times slower
-//! (docs/NOTES.md, "What bounds a lane group"). Each operation here is one IEEE operation per
+//! (docs/design/simulation.md, voice lanes). Each operation here is one IEEE operation per
 //! lane (no fused multiply-add), so a kernel written with them computes the same bits as the
 //! lane-by-lane loop it replaces, and as the plain engine (engine test `lanes`).
 //!

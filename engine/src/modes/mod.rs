@@ -219,7 +219,12 @@ impl Engine {
         let rest = self.rest_positions();
         let net = Network::walk(self, Valuation::Rest(&rest));
         let sys = System::assemble(self, &net, true);
-        solve::modes(&sys, self.info.num_points, self.sample_rate_hz(), count)
+        solve::modes(
+            &sys,
+            self.model.info.num_points,
+            self.sample_rate_hz(),
+            count,
+        )
     }
 
     /// The reference pitch of issue 14: the frequency of the strongest mode (above 20 Hz) that

@@ -139,7 +139,7 @@ impl System {
     /// at rest, with weight 1: a hammer's blow reaches what it hits through the contact,
     /// which the rest state leaves open.
     pub fn assemble(e: &Engine, net: &Network, strike: bool) -> System {
-        let n_points = e.info.num_points;
+        let n_points = e.model.info.num_points;
         let mut dof = vec![None; n_points];
         let mut mass = Vec::new();
         let mut point = Vec::new();
@@ -188,7 +188,7 @@ impl System {
 
         // Inputs (spec §2.2): a force input adds its signal to its target; a position input
         // moves an avatar, whose links push the moving points with −s·(k·u + z·Δu)·d.
-        let num_in = e.info.num_inputs();
+        let num_in = e.model.info.num_inputs();
         let mut inputs = vec![
             Port {
                 p: vec![0.0; n],
@@ -197,7 +197,7 @@ impl System {
             };
             num_in
         ];
-        for r in &e.force_inputs {
+        for r in &e.model.force_inputs {
             let port = &mut inputs[r.channel as usize];
             for (i, w) in dofs(e, &dof, r.index) {
                 port.p[i as usize] += w;
@@ -219,7 +219,7 @@ impl System {
                 }
             }
         }
-        for r in &e.avatars {
+        for r in &e.model.avatars {
             let port = &mut inputs[r.channel as usize];
             port.linear = true;
             for l in &net.links {
@@ -236,7 +236,7 @@ impl System {
 
         // Outputs: a position output reads x (spec §2.2.3); a force output reads the link
         // forces on its points, −f on an endpoint a and +f on an endpoint b (spec §1.3).
-        let num_out = e.info.num_outputs();
+        let num_out = e.model.info.num_outputs();
         let mut outputs = vec![
             Port {
                 p: vec![0.0; n],
@@ -245,16 +245,16 @@ impl System {
             };
             num_out
         ];
-        for r in &e.pos_outputs {
+        for r in &e.model.pos_outputs {
             let port = &mut outputs[r.channel as usize];
             for (i, w) in dofs(e, &dof, r.index) {
                 port.p[i as usize] += w;
                 port.linear = true;
             }
         }
-        for &(channel, start, len) in &e.frc_outputs {
+        for &(channel, start, len) in &e.model.frc_outputs {
             let port = &mut outputs[channel as usize];
-            let sources = &e.frc_sources[start as usize..(start + len) as usize];
+            let sources = &e.model.frc_sources[start as usize..(start + len) as usize];
             for l in &net.links {
                 let s = sources.iter().filter(|&&p| p == l.b).count() as f64
                     - sources.iter().filter(|&&p| p == l.a).count() as f64;
