@@ -581,7 +581,7 @@ fn bench(a: &BenchArgs) -> Result<(), Failure> {
     let mut out = vec![0.0; n_out * block];
     // Passes of one strike each: struck from rest, then one second of audio (so that a damped
     // model never reaches its fixed point, where the engine would hold it instead of
-    // stepping, engine/src/rest.rs). One untimed pass warms up; `ns_per_sample` is the best
+    // stepping, engine/src/sim/rest.rs). One untimed pass warms up; `ns_per_sample` is the best
     // timed pass, as the Faust renderer reports the best of its runs (`compare.sh`), and
     // `mean_ns` their mean (named so that it does not match `ns_per_sample=`).
     let total_blocks = total.div_ceil(block as u64).max(1);

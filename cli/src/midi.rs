@@ -1,6 +1,6 @@
 //! Standard MIDI files (types 0 and 1, read with `midly`) as the instrument's events at
-//! absolute sample times: notes, pitch bend and control changes of every track and channel, with the file's
-//! tempo map (metrical time) or its SMPTE rate (timecode).
+//! absolute sample times: notes, pitch bend and control changes of every track and channel, with
+//! the file's tempo map (metrical time) or its SMPTE rate (timecode).
 
 use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
 use ressort_engine::instrument::Event;

@@ -86,7 +86,7 @@ fn measure(name: &str, spec: &ModelSpec) -> Row {
     let mut out = vec![0.0; e.info().num_outputs() * BLOCK_FRAMES];
     // The model is struck from rest at the start of every simulated second, so that it sounds
     // throughout: a run of a small model simulates minutes, in which a damped model reaches
-    // its fixed point, and the engine then holds it instead of stepping (engine/src/rest.rs).
+    // its fixed point, and the engine then holds it instead of stepping (engine/src/sim/rest.rs).
     let restrike = (SAMPLE_RATE_HZ as usize).div_ceil(BLOCK_FRAMES);
     let mut run = |e: &mut Engine, blocks: usize| {
         for b in 0..blocks {

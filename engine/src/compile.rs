@@ -18,8 +18,8 @@
 //! then `assemble` lays out the motion buffers and builds the engine. Errors are reported by
 //! each pass in script order, pass after pass.
 
-use crate::engine::Engine;
-use crate::motion::DEFAULT_MOTION_INTERVAL_SAMPLES;
+use crate::sim::engine::Engine;
+use crate::sim::motion::DEFAULT_MOTION_INTERVAL_SAMPLES;
 use crate::spec::{ModelSpec, SampleRateMode, REFERENCE_SAMPLE_RATE_HZ};
 use context::Cx;
 
@@ -29,7 +29,6 @@ mod bind;
 mod context;
 mod errors;
 mod kinds;
-pub(crate) mod label_map;
 mod labels;
 mod points;
 
@@ -49,7 +48,7 @@ pub struct CompileOptions {
     pub sample_rate_hz: f64,
     /// The motion refresh interval R in samples (spec §6.1), ≥ 1.
     pub motion_interval: u32,
-    /// Whether a small model's sample loop is also compiled to machine code ([`crate::jit`]:
+    /// Whether a small model's sample loop is also compiled to machine code ([`crate::sim::jit`]:
     /// the same samples, faster). On by default; off runs every model on the interpreter.
     pub jit: bool,
 }

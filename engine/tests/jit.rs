@@ -1,4 +1,4 @@
-//! Small models compiled to machine code (`engine/src/jit.rs`) play what the interpreter
+//! Small models compiled to machine code (`engine/src/sim/jit.rs`) play what the interpreter
 //! plays, bit for bit: outputs, positions, delayed positions, forces, guard events and sample
 //! counts, through odd block sizes, strikes, noise, non-finite input, parameter and gain
 //! changes, guard trips and resets.
@@ -7,8 +7,8 @@ mod common;
 
 use ressort_engine::{compile, parse, CompileOptions, Engine, ParamId, ScaleClass};
 
-/// Every law of the table (a test below holds it to that), both bow profiles, avatars, massG and osc, gravity, a ground at −0, force
-/// outputs, an output on an avatar.
+/// Every law of the table (a test below holds it to that), both bow profiles, avatars, massG and
+/// osc, gravity, a ground at −0, force outputs, an output on an avatar.
 const MIXED: &str = "\
 @K param 0.1
 @Q param 0.5

@@ -114,7 +114,7 @@ fn main() {
                  motion frames)"
             );
         }
-        // Without a motion store a small model runs on its native code (engine/src/jit.rs):
+        // Without a motion store a small model runs on its native code (engine/src/sim/jit.rs):
         // the same life again, on that path.
         drop(e.set_motion_store(None));
         e.apply_pending_changes();

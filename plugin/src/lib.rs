@@ -34,7 +34,8 @@ pub mod report;
 pub mod runtime;
 pub mod voices_watch;
 
-pub use ressort_engine::instrument::{dsp, envelope, host, macros};
+pub use ressort_engine::analysis::envelope;
+pub use ressort_engine::instrument::{dsp, host, macros};
 
 use params::RessortParams;
 use report::{HostLink, MainThreadTask};

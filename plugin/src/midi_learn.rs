@@ -2,7 +2,7 @@
 //! MIDI learn (the editor arms a slot; the next controller the audio thread sees is bound to
 //! it). Atomics only, so the audio thread reads and learns without locks.
 
-use crate::model::NUM_MACROS;
+use ressort_engine::instrument::NUM_MACROS;
 use nice_plug::params::persist::PersistentField;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicI8, AtomicU8, Ordering};

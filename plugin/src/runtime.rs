@@ -32,7 +32,7 @@ pub struct RuntimeStatus {
     pub voices_total: AtomicU32,
     /// The macro slot positions in use (a MIDI controller may have moved a slot away from its
     /// parameter's value).
-    pub macros: [AtomicF64; crate::model::NUM_MACROS],
+    pub macros: [AtomicF64; ressort_engine::instrument::NUM_MACROS],
     /// Set by the editor's reset button; the audio thread resets the model at its next block
     /// and clears the guard flag.
     pub reset_requested: AtomicBool,

@@ -56,7 +56,7 @@ fn the_stiffness_limit_matches_the_stability_analysis() {
         // The limits hold for a key held down: a bow's friction at its pressed value.
         let exciters = p.exciters.clone();
         ressort_engine::instrument::prepare::press_audio_params(&mut p.engine, &exciters);
-        let gershgorin = ressort_engine::instrument::envelope::envelope(&mut p.engine);
+        let gershgorin = ressort_engine::analysis::envelope::envelope(&mut p.engine);
         let bound = gershgorin.max_stiffness(1.0);
         let exact = p.engine.exact_stability();
         match exact.max_stiffness(1.0) {

@@ -5,14 +5,15 @@ use super::bind::Bound;
 use super::context::Cx;
 use super::errors::CompileErrors;
 use super::kinds::Kinds;
-use super::label_map::LabelMap;
 use super::labels::Params;
 use super::points::Numbering;
 use super::{CompileOptions, Rate};
-use crate::control::ControlArgs;
-use crate::engine::{ArgClass, Compiled, Engine, Points, DEFAULT_POSITION_LIMIT, NUM_ARG_CLASSES};
-use crate::info::{ModelInfo, ParamInfo};
-use crate::motion::{MotionLayout, NamedBuffer};
+use crate::laws::{ArgClass, NUM_ARG_CLASSES};
+use crate::sim::control::ControlArgs;
+use crate::sim::engine::{Compiled, Engine, Points, DEFAULT_POSITION_LIMIT};
+use crate::sim::info::{ModelInfo, ParamInfo};
+use crate::sim::motion::{MotionLayout, NamedBuffer};
+use crate::spec::label_map::LabelMap;
 use crate::spec::{Element, ElementKind, SampleRateMode, ScaleClass, Vector};
 use std::sync::Arc;
 
@@ -96,7 +97,7 @@ impl<'a> Cx<'a> {
         );
         let mut macros = bound.macros;
         macros.scratch_ext = vec![(0, 0.0); 4 * num_proxies];
-        let arch = crate::kernels::arch_for(&macros);
+        let arch = crate::sim::kernels::arch_for(&macros);
         let model = Compiled {
             info,
             program: self.program,
@@ -113,7 +114,6 @@ impl<'a> Cx<'a> {
             init_runs: bound.init_runs,
             init_fixed_points: numbering.fixed_points,
             motion_interval: options.motion_interval.max(1),
-            native: None,
         };
         let mut engine = Engine {
             model: Arc::new(model),
@@ -141,20 +141,16 @@ impl<'a> Cx<'a> {
             motion_counter: 0,
             rest: Default::default(),
             arch,
+            native: None,
             native_fits: false,
         };
         engine.reset();
         if options.jit {
-            let native = crate::jit::NativeCode::build(&engine);
-            // The only reference: the model is shared from the first clone on.
-            if let Some(model) = Arc::get_mut(&mut engine.model) {
-                model.native = native;
-            }
+            engine.native = crate::sim::jit::NativeCode::build(&engine.parts()).map(Arc::new);
             engine.native_fits = engine
-                .model
                 .native
                 .as_ref()
-                .is_some_and(|code| code.fits(&engine));
+                .is_some_and(|code| code.fits(&engine.parts()));
         }
         Ok(engine)
     }

@@ -3,7 +3,7 @@
 //!
 //! The engine runs a band — links j = (q + j, q + j + d) over a contiguous point range, or
 //! the reverse (q + j + d, q + j) — as two contiguous loops instead of a gather and scatter
-//! ([`crate::kernels::links::Group::apply`]), but it finds bands in list order only. A script
+//! ([`crate::sim::kernels::links::Group::apply`]), but it finds bands in list order only. A script
 //! that writes a mesh's row link, column link, row link… or a `~generate triangle`, `hexagon`
 //! or `lattice`, or a MIMS4Max export, interleaves its bands. This pass sorts each group's links
 //! by (direction, d, first point), cuts the sorted list into runs of consecutive first points,
@@ -18,8 +18,8 @@
 //! (`~generate triangle size=30`: 1,287 of 1,305 links banded either way, 1,400 → 1,125 ns).
 
 use super::kinds::{LinkGroups, Row};
-use crate::kernels::links::{find_bands, MIN_CHAIN};
 use crate::laws::LawKind;
+use crate::sim::kernels::links::{find_bands, MIN_CHAIN};
 
 /// How many of a link list's links the engine runs in bands.
 fn banded(a: &[u32], b: &[u32]) -> usize {

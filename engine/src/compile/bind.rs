@@ -7,13 +7,13 @@ use super::context::Cx;
 use super::kinds::Kinds;
 use super::points::Numbering;
 use super::Rate;
-use crate::engine::{
-    ArgClass, InitRule, InitRun, Interactions, LineMacro, MacroSlots, Macros, MeshMacro,
-    SingleMasses,
-};
-use crate::expr::Expr;
-use crate::kernels::masses::Update;
+use crate::laws::ArgClass;
 use crate::laws::LawKind;
+use crate::sim::engine::{
+    InitRule, InitRun, Interactions, LineMacro, MacroSlots, Macros, MeshMacro, SingleMasses,
+};
+use crate::sim::kernels::masses::Update;
+use crate::spec::expr::Expr;
 use crate::spec::{ElementKind, MacroKind, SampleRateMode, REFERENCE_SAMPLE_RATE_HZ};
 
 /// The bound kinds, ready to run.
@@ -225,7 +225,7 @@ impl<'a> Cx<'a> {
         }
         macros.scratch_v = vec![0.0; largest_macro];
         // The row sweep of a large mesh takes some rows of its own.
-        let rows = crate::kernels::mesh::SCRATCH_ROWS;
+        let rows = crate::sim::kernels::mesh::SCRATCH_ROWS;
         let widest = macros
             .meshes
             .iter()

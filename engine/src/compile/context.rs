@@ -2,10 +2,11 @@
 //! checks and compilation, argument binding, and the resolution of an endpoint to a point.
 
 use super::errors::{CompileError, CompileErrorKind};
-use super::label_map::{LabelKey, LabelMap};
 use super::MAX_EXPR_DEPTH;
-use crate::engine::{ArgClass, Binding, Proxies};
-use crate::expr::{Expr, ExprRef, Program};
+use crate::laws::ArgClass;
+use crate::sim::engine::{Binding, Proxies};
+use crate::spec::expr::{Expr, ExprRef, Program};
+use crate::spec::label_map::{LabelKey, LabelMap};
 use crate::spec::{ElementKind, Endpoint, ModelSpec, Span};
 
 /// What a label resolves to: a parameter, or an element with what it is.

@@ -9,10 +9,11 @@ use super::context::Cx;
 use super::errors::CompileErrorKind;
 use super::labels::Params;
 use super::points::Numbering;
-use crate::engine::{ArgClass, Route};
-use crate::expr::Expr;
-use crate::info::{InputUse, OutputUse};
+use crate::laws::ArgClass;
 use crate::laws::LawKind;
+use crate::sim::engine::Route;
+use crate::sim::info::{InputUse, OutputUse};
+use crate::spec::expr::Expr;
 use crate::spec::{ElementKind, Endpoint, Law};
 
 /// A link (an interaction element) of one law: its two points and its argument expressions,

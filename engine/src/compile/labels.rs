@@ -4,10 +4,10 @@
 
 use super::context::{Cx, Role, Symbol};
 use super::errors::{CompileError, CompileErrorKind};
-use super::label_map::LabelKey;
-use crate::engine::Route;
-use crate::expr::Func;
-use crate::info::ParamInfo;
+use crate::sim::engine::Route;
+use crate::sim::info::ParamInfo;
+use crate::spec::expr::Func;
+use crate::spec::label_map::LabelKey;
 use crate::spec::ParamKind;
 use std::collections::hash_map::Entry;
 

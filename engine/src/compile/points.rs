@@ -5,7 +5,7 @@
 use super::context::Cx;
 use super::errors::CompileErrorKind;
 use super::MAX_POINTS;
-use crate::info::{OwnerInfo, PointInfo, PointKind};
+use crate::sim::info::{OwnerInfo, PointInfo, PointKind};
 use crate::spec::{ElementKind, MacroKind, MacroSpec};
 
 /// The points of a model and the elements that own them.
@@ -184,7 +184,7 @@ fn fixed_nodes(mac: &MacroSpec) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::expr::Expr;
+    use crate::spec::expr::Expr;
     use crate::spec::Vector;
 
     #[test]

@@ -1,16 +1,16 @@
 //! The modes of a prepared model at the instrument's controls (issue 14, the editor's Modes
-//! view): the modal analysis of [`crate::modes`] run on a copy of the model with the gains
-//! and macro values the instrument would put on it for a note at the reference key.
+//! view): the modal analysis of [`crate::analysis::modes`] run on a copy of the model with the
+//! gains and macro values the instrument would put on it for a note at the reference key.
 //!
 //! The copy is taken when the model is prepared, off the audio thread, and analysed on a
 //! worker thread: nothing here runs in `process()`.
 
 use super::controls::{ClampView, Controls, Smoothed};
-use super::envelope::StabilityEnvelope;
 use super::gains::Gains;
 use super::macros::MacroBinding;
 use super::prepare::Prepared;
-use crate::modes::ModalAnalysis;
+use crate::analysis::envelope::StabilityEnvelope;
+use crate::analysis::modes::ModalAnalysis;
 use crate::Engine;
 
 /// What the modal analysis needs of a prepared model.
@@ -73,7 +73,7 @@ impl ModalModel {
     }
 
     /// The modes of the model with `controls` applied ([`Engine::modes`]: every mode of a
-    /// model up to [`crate::modes::DENSE_LIMIT`] moving points, else the lowest `count`).
+    /// model up to [`crate::analysis::modes::DENSE_LIMIT`] moving points, else the lowest `count`).
     /// Takes up to a few seconds on the largest models.
     pub fn modes(&mut self, controls: &Controls, count: Option<usize>) -> ModesAtControls {
         let gains = self.gains(controls);

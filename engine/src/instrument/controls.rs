@@ -6,11 +6,11 @@
 //! sin²(πf/SR) = K/4M (spec §5.3), see [`tuning_gain`].
 
 use super::dsp::{db_to_gain, tuning_gain, ChunkSmoother};
-use super::envelope::StabilityEnvelope;
 use super::gains::{Controlled, ControlsKey, Gains, TuningMemo};
 use super::macros::MacroBinding;
 use super::prepare::Prepared;
 use super::{CHUNK, NUM_MACROS};
+use crate::analysis::envelope::StabilityEnvelope;
 use crate::ScaleClass;
 
 /// The range of the A4 reference, Hz.

@@ -9,21 +9,23 @@
 //!    an avatar's position. It is taken off each copy of the model before the output stage, so
 //!    that a voice's note-on is no step of the hammer's height into the output.
 //! 2. **A note**: C4 at velocity 0.8 ([`MEASURE_KEY`], [`MEASURE_VELOCITY`]), held for the
-//!    render, the peak of every output measured (the main pair and the auxiliary ones). The output trim puts that peak at
-//!    [`TARGET_DBFS`]; Output Gain (0 dB by default) adds to it. Velocity still scales the
-//!    strike, so softer notes stay softer.
-//! 3. **A drum**: a reference kick on the sidechain channels that feed the model, peaking at [`REFERENCE_DRUM_DBFS`] (a sine gliding 150 → 45
-//!    Hz under an 80 ms decay). The input trim of the host signals that push the model (on its
-//!    force and position inputs) makes its answer peak as high as the note did, so a normal drum strikes like a medium note and a hot one stays
-//!    below the ceiling. Force and Position Gain (0 dB) add to it. Models the sidechain does
-//!    not push keep 0 dB. A hammer between the input and the model makes the
+//!    render, the peak of every output measured (the main pair and the auxiliary ones). The
+//!    output trim puts that peak at [`TARGET_DBFS`]; Output Gain (0 dB by default) adds to it.
+//!    Velocity still scales the strike, so softer notes stay softer.
+//! 3. **A drum**: a reference kick on the sidechain channels that feed the model, peaking at
+//!    [`REFERENCE_DRUM_DBFS`] (a sine gliding 150 → 45 Hz under an 80 ms decay). The input
+//!    trim of the host signals that push the model (on its force and position inputs) makes its
+//!    answer peak as high as the note did, so a normal drum strikes like a medium note and a
+//!    hot one stays below the ceiling. Force and Position Gain (0 dB) add to it. Models the
+//!    sidechain does not push keep 0 dB. A hammer between the input and the model makes the
 //!    answer far from proportional (a weak push presses the hammer onto a plate, or does not
 //!    reach the string at all), so the trim is checked by playing the kick through it and
 //!    corrected until the two peaks agree within 2 dB (at most four more renders).
 //!
-//! A render is at most [`SECONDS`] long, shortened for large models to [`WORK_BUDGET`] element-steps (the 150 × 150 plate
-//! gets 3,000 samples, its peak comes after about 1,400). A model silent from the note takes
-//! its level from the drum; a model silent from both keeps 0 dB.
+//! A render is at most [`SECONDS`] long, shortened for large models to [`WORK_BUDGET`]
+//! element-steps (the 150 × 150 plate gets 3,000 samples, its peak comes after about 1,400). A
+//! model silent from the note takes its level from the drum; a model silent from both keeps
+//! 0 dB.
 
 use super::controls::Controls;
 use super::events::{Event, Timed};

@@ -1,9 +1,9 @@
 //! Macro slots: the model's `param`s and `audioParam`s bound to the generic host parameters,
 //! with ranges the stability analysis accepts.
 
-use super::envelope::{worst_load, STABILITY_HEADROOM};
 use super::host::HostSettings;
 use super::NUM_MACROS;
+use crate::analysis::envelope::{worst_load, STABILITY_HEADROOM};
 use crate::{Engine, ParamId};
 
 /// A macro slot bound to one of the model's `param`s or `audioParam`s. For an `audioParam`

@@ -21,10 +21,8 @@
 //! sample. Nothing here allocates, locks or does I/O after [`Instrument::new`].
 
 pub mod analysis;
-mod concurrent;
 pub mod controls;
 pub mod dsp;
-pub mod envelope;
 pub mod events;
 pub mod exciters;
 pub mod gains;
@@ -37,9 +35,9 @@ pub mod trigger;
 pub mod units;
 pub mod voices;
 
+pub use crate::analysis::envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
 pub use analysis::{ModalModel, ModesAtControls};
 pub use controls::Controls;
-pub use envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
 pub use events::{Event, Timed};
 pub use gains::Gains;
 pub use host::HostSettings;

@@ -3,14 +3,16 @@
 //! the note input, stability envelopes, macro bindings, the reference pitch, scratch
 //! buffers). The audio thread then only runs a [`Prepared`] model.
 
-use super::envelope::{envelope, exact_envelope, raw_envelope, worst_load, StabilityEnvelope};
 use super::exciters::{self, Exciter, Gestures};
 use super::host::HostSettings;
 use super::macros::{macro_bindings, MacroBinding};
 use super::units::{unit_of, MacroUnit};
 use super::voices::VoiceBank;
 use super::CHUNK;
-use crate::modes::ModalAnalysis;
+use crate::analysis::envelope::{
+    envelope, exact_envelope, raw_envelope, worst_load, StabilityEnvelope,
+};
+use crate::analysis::modes::ModalAnalysis;
 use crate::{
     compile, parse, CompileOptions, Element, ElementKind, Engine, ExciterKind, InputUse, ModelSpec,
     RouteSource, SampleRateMode, Span, REFERENCE_SAMPLE_RATE_HZ,
@@ -428,10 +430,10 @@ pub fn reference_mode(a: &ModalAnalysis, input: usize) -> Option<f64> {
 }
 
 /// The model's reference pitch (issue 14): the strongest mode that `@out1` hears from the note
-/// input, by the modal analysis ([`crate::modes`]), for models of any size: dense and exact up
-/// to [`crate::modes::DENSE_LIMIT`] moving points, the strongest of the lowest
-/// [`crate::modes::DEFAULT_SPARSE_COUNT`] above (about 2 s for the 150 × 150 plate). Models the
-/// analysis cannot read (a note input with no linear path) fall back to the impulse
+/// input, by the modal analysis ([`crate::analysis::modes`]), for models of any size: dense and
+/// exact up to [`crate::analysis::modes::DENSE_LIMIT`] moving points, the strongest of the lowest
+/// [`crate::analysis::modes::DEFAULT_SPARSE_COUNT`] above (about 2 s for the 150 × 150 plate).
+/// Models the analysis cannot read (a note input with no linear path) fall back to the impulse
 /// response's strongest peak ([`estimate_pitch`]), within its work budget.
 /// What each input channel of `engine` holds when nothing feeds it: a position input its
 /// avatar's declared position (so a silent input leaves the avatar where the script puts it),
@@ -471,7 +473,7 @@ const UNITS_BUDGET_S: f64 = 0.25;
 
 /// The unit of every macro slot ([`super::units`]): frequencies and decays of the reference
 /// mode (the strongest from the note input, or `@in1`, to `@out1`) come from the dense modal
-/// analysis, for models up to [`crate::modes::DENSE_LIMIT`] points, within
+/// analysis, for models up to [`crate::analysis::modes::DENSE_LIMIT`] points, within
 /// [`UNITS_BUDGET_S`].
 fn macro_units(
     engine: &mut Engine,
@@ -479,8 +481,8 @@ fn macro_units(
     note_input: Option<usize>,
 ) -> Vec<MacroUnit> {
     // The reference mode is measured by the dense analysis only, and needs an output.
-    let measurable =
-        engine.info().num_points <= crate::modes::DENSE_LIMIT && engine.info().num_outputs() > 0;
+    let measurable = engine.info().num_points <= crate::analysis::modes::DENSE_LIMIT
+        && engine.info().num_outputs() > 0;
     let input = note_input.unwrap_or(0) + 1;
     let params = engine.info().params.clone();
     let reference = |e: &mut Engine| -> Option<(f64, f64)> {

@@ -5,8 +5,8 @@
 //!
 //! What a parameter is comes from the stability analysis (spec §5.2): moving it changes the
 //! masses' M, or their attached stiffness K_eq, or damping Z_eq. The frequencies and decays
-//! come from the modal analysis ([`crate::modes`]) at the slot's ends and its centre, and are
-//! interpolated between them: the slot is geometric in the value on each side of its centre,
+//! come from the modal analysis ([`crate::analysis::modes`]) at the slot's ends and its centre, and
+//! are interpolated between them: the slot is geometric in the value on each side of its centre,
 //! and a mode's frequency a power of its stiffness in the low-frequency limit, so piecewise
 //! log-linear.
 
@@ -152,9 +152,9 @@ pub fn unit_of(
         // The positions at once: each but the first on its own thread, with its own copy of
         // the engine.
         let (mut middle, mut high) = (engine.clone(), engine.clone());
-        let ((v_high, v_middle), v_low) = super::concurrent::join(
+        let ((v_high, v_middle), v_low) = crate::analysis::concurrent::join(
             || {
-                super::concurrent::join(
+                crate::analysis::concurrent::join(
                     || measure(&mut high, TABLE_POSITIONS[2]),
                     || measure(&mut middle, TABLE_POSITIONS[1]),
                 )

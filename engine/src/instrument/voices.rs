@@ -16,7 +16,7 @@
 use super::exciters::{self, Exciter, Gestures};
 use super::gains::{Controlled, Gains, TuneKey, TuningMemo};
 use super::CHUNK;
-use crate::lanes::{LaneEngine, LANES};
+use crate::sim::lanes::{LaneEngine, LANES};
 use crate::{Engine, ParamId, ScaleClass};
 
 mod upkeep;
@@ -745,8 +745,8 @@ mod tests {
         }
     }
 
-    /// Voices spread over four lane groups are packed into as few as hold them, and every voice goes on bit for
-    /// bit as it would have where it was.
+    /// Voices spread over four lane groups are packed into as few as hold them, and every voice
+    /// goes on bit for bit as it would have where it was.
     #[test]
     fn sounding_voices_are_packed_into_few_lane_groups() {
         let mut bank = VoiceBank::new(&oscillator(), 1, 1, 4 * LANES, 48000.0);

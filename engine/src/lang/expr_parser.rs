@@ -19,7 +19,7 @@ use super::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use super::lexer::is_blank;
 use super::numbers::{plain_number, scan_number, to_f64, NumberError};
 use super::symbols::{SymKind, Symbols};
-use crate::expr::{BinOp, Expr, Func};
+use crate::spec::expr::{BinOp, Expr, Func};
 
 /// The deepest nesting (parentheses, calls, unary operators) and the deepest expression tree the
 /// front end accepts. Below the compiler's own limit of 256 (`compile::MAX_EXPR_DEPTH`).

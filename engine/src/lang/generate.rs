@@ -6,7 +6,7 @@
 //! ```
 //!
 //! The directive expands inline, at its line, into the explicit elements of
-//! [`crate::generators`]: the parameters `NAME_M`, `NAME_K`, `NAME_Z`, `NAME_Zo` (and
+//! [`crate::spec::generators`]: the parameters `NAME_M`, `NAME_K`, `NAME_Z`, `NAME_Zo` (and
 //! `NAME_Ks` for the stiff string), then the nodes (`NAME_m<k>`, `NAME_m<a>_<b>`,
 //! `NAME_m<a>_<b>_<c>`, end grounds `NAME_g0`/`NAME_g1`), then the links (`NAME_r<k>`). Later
 //! (and earlier) lines address the nodes by label. Generated points join every buffer scope open
@@ -23,7 +23,7 @@ use super::expr_parser::{is_identifier, parse_expression, ExprContext};
 use super::lexer::{col_plus, is_blank, split_items, width, TokKind, Token};
 use super::numbers::{parse_number_literal, NumberError};
 use super::symbols::Symbols;
-use crate::generators::{
+use crate::spec::generators::{
     generate, Fixed, Generator, GeneratorError, LatticeFixed, Topology, MAX_GENERATED_LINKS,
     MAX_GENERATED_NODES,
 };

@@ -8,7 +8,8 @@
 //!   a mesh. The proxy branch wrote the macro's label bare in the endpoint or target slot and
 //!   put the coordinates at the **end of the line**, one per bare macro, endpoint 1's before
 //!   endpoint 2's (MIMS branch `ProxyConnections`, `physicsGenerator/physicsGen.py`: `l[-2]` for
-//!   m1, `l[-1]` for m2); a mesh point was one token `u:w`. So `@in1 frcInput @s 0.3` is `@in1 frcInput [@s 0.3]`, `@c contact @s @in2 K Z 0.
+//!   m1, `l[-1]` for m2); a mesh point was one token `u:w`. So `@in1 frcInput @s 0.3` is `@in1
+//! frcInput [@s 0.3]`, `@c contact @s @in2 K Z 0.
 //!   α` is `@c contact [@s α] @in2 K Z 0.`, and `@out1 posOutput @me u:w` is `@out1 posOutput
 //!   [@me u w]`. A mesh point may also be written as two tokens `u w`.
 //! * **Macros without velocity.** The proxy branch's macros ended at the position

@@ -17,8 +17,8 @@
 //! notation, expressions with the functions of §3.5, legacy `massG`, two-parameter `spring` and
 //! `nlSpring`, `~samplerate raw|scaled`, nested and overlapping buffer scopes (§3.10), legacy
 //! trailing buffer tags (§6.4), the proxy branch's bare connection points and macros without
-//! velocity (read as the modern form, with a note; §3.14), and the `~generate` directive, which expands a topology
-//! generator of §4 inline into explicit, addressable elements:
+//! velocity (read as the modern form, with a note; §3.14), and the `~generate` directive, which
+//! expands a topology generator of §4 inline into explicit, addressable elements:
 //!
 //! ```
 //! use ressort_engine::lang::parse;

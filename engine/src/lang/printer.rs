@@ -10,7 +10,7 @@
 //! `[ ]` (§3.3); inside vectors and connection points they are parenthesised (§3.7, §2.8).
 
 use super::expr_parser::is_identifier;
-use crate::expr::{format_number, BinOp, Expr};
+use crate::spec::expr::{format_number, BinOp, Expr};
 use crate::spec::{
     Element, ElementKind, Endpoint, Law, LawForm, MacroSpec, ModelSpec, ParamKind, SampleRateMode,
     Vector,

@@ -1,7 +1,7 @@
 //! The symbol table of a script: every label, what it names and where it was declared
 //! (spec §3.4), for name resolution and endpoint checks.
 
-use crate::compile::label_map::LabelMap;
+use crate::spec::label_map::LabelMap;
 use std::borrow::Cow;
 use std::collections::hash_map::Entry;
 use std::collections::HashSet;

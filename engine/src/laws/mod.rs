@@ -14,8 +14,10 @@
 //! analyses all read the table ([`table`]).
 
 mod arith;
+mod classes;
 mod cubic;
 pub(crate) mod linear;
+pub(crate) use classes::{ArgClass, NUM_ARG_CLASSES};
 mod table;
 
 // The laws, one file each.

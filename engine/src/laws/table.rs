@@ -11,14 +11,14 @@
 //! that a pass forgot would be a compile error, not a silent omission.
 
 use super::LawKind;
-use crate::engine::ArgClass;
+use crate::laws::ArgClass;
 
 /// Declares [`LawKind`] and its dispatch from one list of `Variant => LawType` lines (the
 /// table, in `laws/mod.rs`).
 macro_rules! laws {
     ($($(#[$doc:meta])* $name:ident => $law:ty,)*) => {
         /// An interaction law, in the order of its group in the compiled model
-        /// ([`crate::engine::Interactions`]), which is also the order the kernels apply the
+        /// ([`crate::sim::engine::Interactions`]), which is also the order the kernels apply the
         /// groups in within a sample.
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
         pub enum LawKind {

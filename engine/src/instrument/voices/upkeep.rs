@@ -2,7 +2,7 @@
 //! sounding voices into as few lane groups as hold them.
 
 use super::{group, Copies, Voice, VoiceBank, VoiceState, FREE_LEVEL, MOTION_CHECK};
-use crate::lanes::LANES;
+use crate::sim::lanes::LANES;
 
 impl VoiceBank {
     /// Counts a span of `len` samples; every [`MOTION_CHECK`] samples, measures every

@@ -3,11 +3,11 @@
 
 use super::keywords::Shape;
 use super::{At, Builder, MAX_MACRO_NODES};
-use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::legacy;
 use crate::lang::lexer::Token;
 use crate::laws::LawKind;
+use crate::spec::expr::Expr;
 use crate::spec::LawForm;
 use crate::spec::{ElementKind, Law, MacroKind, MacroSpec};
 

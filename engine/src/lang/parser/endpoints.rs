@@ -2,11 +2,11 @@
 //! `[@macro α]` / `[@mesh u w]`, legacy bare forms included (§3.14).
 
 use super::{At, Builder};
-use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::legacy;
 use crate::lang::lexer::{after_first, col_plus, split_items, TokKind, Token};
 use crate::lang::symbols::SymKind;
+use crate::spec::expr::Expr;
 use crate::spec::{label, Endpoint};
 
 impl Builder<'_> {

@@ -95,7 +95,7 @@ pub(super) fn declare_labels<'a>(
 /// earlier is reported once, at the generator's name; the directive is then not expanded.
 /// Returns true when every label was free.
 fn declare_generated(req: &GenRequest, symbols: &mut Symbols, diags: &mut Diags) -> bool {
-    let plan = match crate::generators::plan(&req.name, &req.topology) {
+    let plan = match crate::spec::generators::plan(&req.name, &req.topology) {
         Ok(plan) => plan,
         Err(e) => {
             // `generate::read` checked the sizes; report anything else rather than panic.

@@ -3,11 +3,11 @@
 
 use super::keywords::Shape;
 use super::{At, Builder};
-use crate::expr::Func;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::expr_parser::is_identifier;
 use crate::lang::lexer::{TokKind, Token};
 use crate::lang::numbers::{parse_number_literal, token_number_literal, NumberError};
+use crate::spec::expr::Func;
 use crate::spec::{ParamDecl, ParamKind, Span};
 
 impl Builder<'_> {

@@ -2,12 +2,12 @@
 //! sizes (§2.7) and the channel numbers of input and output labels.
 
 use super::{At, Builder, MAX_MACRO_NODES};
-use crate::expr::Expr;
 use crate::lang::diagnostics::DiagnosticCode;
 use crate::lang::expr_parser::{parse_expression, ExprContext};
 use crate::lang::lexer::{col_plus, is_blank, split_items, BracketItem, TokKind, Token};
 use crate::lang::numbers::plain_number;
 use crate::lang::symbols::SymKind;
+use crate::spec::expr::Expr;
 use crate::spec::Vector;
 
 impl Builder<'_> {
