@@ -162,6 +162,7 @@ fn set_param(model: &mut Prepared, c: &mut Controls, text: &str) -> Result<(), F
             ))
         })?;
     if let Some((slot, b)) = model
+        .facts()
         .macros
         .iter()
         .enumerate()
@@ -240,7 +241,7 @@ fn note(text: &str, sample_rate: f64) -> Result<Vec<(u64, Event)>, Failure> {
 /// exciters and its automatic trims.
 pub fn describe(m: &Prepared) -> String {
     use ressort_engine::modes::note_name;
-    let s = &m.settings;
+    let s = &m.facts().settings;
     let key_name = |k: f64| {
         note_name(440.0 * 2f64.powf((k.round() - 69.0) / 12.0)).map_or(String::new(), |n| n.0)
     };
@@ -251,7 +252,7 @@ pub fn describe(m: &Prepared) -> String {
         }
         None => "no reference pitch".to_string(),
     };
-    let mode = if m.conventions == instrument::Conventions::Legacy {
+    let mode = if m.facts().conventions == instrument::Conventions::Legacy {
         format!("relative to key {:.2} (legacy project)", s.reference_key)
     } else if s.unpitched {
         format!("unpitched: as written at key {:.0}", s.reference_key)
@@ -269,10 +270,11 @@ pub fn describe(m: &Prepared) -> String {
         })
         .unwrap_or_default();
     let exciters: Vec<String> = m
+        .facts()
         .exciters
         .iter()
         .map(|x| format!("{} in{}", x.kind.name(), x.input + 1))
-        .chain(m.note_input.map(|k| format!("strike in{}", k + 1)))
+        .chain(m.facts().note_input.map(|k| format!("strike in{}", k + 1)))
         .collect();
     format!(
         "ressort: {pitch}, {mode}{top}; a key plays: {}; output trim {:+.1} dB, sidechain force \
@@ -282,8 +284,8 @@ pub fn describe(m: &Prepared) -> String {
         } else {
             exciters.join(", ")
         },
-        20.0 * m.output_trim.log10(),
-        20.0 * m.input_trim.log10()
+        20.0 * m.facts().output_trim.log10(),
+        20.0 * m.facts().input_trim.log10()
     )
 }
 
@@ -314,7 +316,10 @@ pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
         }
     };
     // --voices, else the script's `~voices`, as the plugin's Voices does by default.
-    if let Some(v) = a.voices.or(model.settings.voices.map(|v| v as usize)) {
+    if let Some(v) = a
+        .voices
+        .or(model.facts().settings.voices.map(|v| v as usize))
+    {
         if !(1..=MAX_VOICES).contains(&v) {
             return Err(usage(format!(
                 "--voices {v}: the plugin plays 1 to {MAX_VOICES} voices"
@@ -377,10 +382,10 @@ pub fn render(a: &RenderArgs, total: Option<u64>) -> Result<(), Failure> {
     });
 
     // Stereo like the plugin's main output; aux pairs for @out3 … when the model has them.
-    let channels = if model.num_outputs <= 2 {
+    let channels = if model.facts().num_outputs <= 2 {
         2
     } else {
-        model.num_outputs.min(MAX_HOST_OUTPUTS).div_ceil(2) * 2
+        model.facts().num_outputs.min(MAX_HOST_OUTPUTS).div_ceil(2) * 2
     };
     let mut ccs = [None; instrument::NUM_MACROS];
     for m in &a.cc_maps {
@@ -500,7 +505,12 @@ pub fn bench_voices(
         prepared.engine.info().num_points,
         prepared.engine.info().num_interactions,
     );
-    let key = prepared.settings.reference_key.round().clamp(0.0, 127.0) as u8;
+    let key = prepared
+        .facts()
+        .settings
+        .reference_key
+        .round()
+        .clamp(0.0, 127.0) as u8;
     let mut controls = Controls::DEFAULT;
     let mut inst = Instrument::new(sample_rate, controls);
     inst.set_model(Box::new(prepared));

@@ -148,7 +148,7 @@ fn render_as_plugin_writes_what_the_instrument_plays() {
     controls.stiffness_octaves = 1.0;
     controls.output_db = -6.0;
     let prepared = instrument::prepare("m", MODEL, SR as f64).unwrap();
-    let binding = prepared.macros[0].clone().expect("K is on Macro 1");
+    let binding = prepared.facts().macros[0].clone().expect("K is on Macro 1");
     controls.macros[0] = binding.normalized_of(0.03);
     let events = [
         (

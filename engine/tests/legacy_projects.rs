@@ -44,7 +44,7 @@ fn digest(channels: &[Vec<f32>]) -> u64 {
 fn play(script: &str, events: &[(u32, Event)], sidechain: Option<&[f32]>) -> u64 {
     let mut model = instrument::prepare_with("legacy", script, SR, Conventions::Legacy)
         .expect("the preset prepares");
-    if let Some(v) = model.settings.voices {
+    if let Some(v) = model.facts().settings.voices {
         model.set_voices(v as usize);
     }
     let controls = Controls::LEGACY;

@@ -246,6 +246,7 @@ fn a_large_model_is_prepared_with_its_modal_reference_pitch() {
     let sr = 44_100.0;
     let prepared = ressort_engine::instrument::prepare("plate", &text, sr).expect("prepares");
     let pitch = prepared
+        .facts()
         .settings
         .reference_pitch_hz
         .expect("a reference pitch");

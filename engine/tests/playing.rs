@@ -93,7 +93,7 @@ fn db(x: f64) -> f64 {
 impl Player {
     fn new(script: &str, sample_rate: f64) -> Player {
         let mut model = instrument::prepare("test", script, sample_rate).expect("it prepares");
-        if let Some(v) = model.settings.voices {
+        if let Some(v) = model.facts().settings.voices {
             model.set_voices(v as usize);
         }
         Player {
@@ -123,7 +123,7 @@ impl Player {
         if let Some(b) = model.bank.as_mut() {
             b.clear();
         }
-        let channels = match model.num_outputs {
+        let channels = match model.facts().num_outputs {
             0..=2 => 2,
             n => n.min(MAX_HOST_OUTPUTS).div_ceil(2) * 2,
         };
@@ -218,7 +218,7 @@ fn every_preset_lands_in_the_level_band_and_velocity_is_loudness() {
 /// most three octaves below its pitch, not above its highest key), then its own key and the
 /// fifth and octave below it.
 fn keys_of(m: &Prepared) -> Vec<u8> {
-    let own = m.settings.reference_key;
+    let own = m.facts().settings.reference_key;
     let top = m.highest_key().unwrap_or(own + 12.0).floor();
     let mut keys: Vec<u8> = [48.0, 60.0, 69.0, own.round()]
         .into_iter()
@@ -279,11 +279,12 @@ fn pitched_presets_play_in_tune_at_three_keys_and_three_rates() {
     for (name, script) in presets() {
         for sr in [44_100.0, 48_000.0, 96_000.0] {
             let mut p = Player::new(&script, sr);
-            if p.model().settings.unpitched {
+            if p.model().facts().settings.unpitched {
                 break;
             }
             let bowed = p
                 .model()
+                .facts()
                 .exciters
                 .iter()
                 .any(|x| x.kind == ExciterKind::Bow);
@@ -477,7 +478,7 @@ fn a_press_holds_its_depth_while_the_key_is_down_and_lets_go() {
         2.0,
     );
     let left = take.left();
-    let gain = 10f64.powf(-30.0 / 20.0) * p.model().output_trim;
+    let gain = 10f64.powf(-30.0 / 20.0) * p.model().facts().output_trim;
     // Pressed by 0.5 through an equal spring, the oscillator settles halfway, at 0.25.
     let held = left[off - 1] / gain;
     assert!((held - 0.25).abs() < 0.01, "held at {held}");
@@ -633,7 +634,13 @@ fn the_guides_exciter_examples_play() {
     );
     for script in examples {
         let mut p = Player::new(script, SR);
-        let kinds: Vec<&str> = p.model().exciters.iter().map(|x| x.kind.name()).collect();
+        let kinds: Vec<&str> = p
+            .model()
+            .facts()
+            .exciters
+            .iter()
+            .map(|x| x.kind.name())
+            .collect();
         let take = p.play(
             Controls::DEFAULT,
             &[

@@ -354,7 +354,11 @@ fn drunk_triangles_play_100_overlapping_notes_and_free_their_voices() {
         "/../models/drunk-triangles.mdl"
     ))
     .unwrap();
-    let settings = instrument::prepare("dt", &text, SR).unwrap().settings;
+    let settings = instrument::prepare("dt", &text, SR)
+        .unwrap()
+        .facts()
+        .settings
+        .clone();
     assert_eq!(settings.voices, Some(100));
     // Forty keys around C4, where the unpitched triangle sounds as written.
     let low = settings.reference_key.round() as u32 - 20;

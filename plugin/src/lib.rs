@@ -166,7 +166,7 @@ impl Ressort {
         let Some(new) = self.store.receive() else {
             return;
         };
-        if new.sample_rate != self.sample_rate {
+        if new.facts().sample_rate != self.sample_rate {
             self.recycle(Some(new));
             return;
         }

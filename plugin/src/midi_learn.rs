@@ -2,8 +2,8 @@
 //! MIDI learn (the editor arms a slot; the next controller the audio thread sees is bound to
 //! it). Atomics only, so the audio thread reads and learns without locks.
 
-use ressort_engine::instrument::NUM_MACROS;
 use nice_plug::params::persist::PersistentField;
+use ressort_engine::instrument::NUM_MACROS;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicI8, AtomicU8, Ordering};
 use std::sync::Arc;

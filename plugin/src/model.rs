@@ -95,7 +95,7 @@ pub fn prepare(
     playing: Playing,
 ) -> Result<(Prepared, MotionReader), Rejected> {
     let mut prepared = instrument::prepare_with(name, text, sample_rate, playing.conventions())?;
-    let declared = prepared.settings.voices.unwrap_or(1) as usize;
+    let declared = prepared.facts().settings.voices.unwrap_or(1) as usize;
     prepared.set_voices(if voices == 0 { declared } else { voices });
     let (writer, reader) = motion_channel(&prepared.engine, sample_rate);
     prepared.watcher = Some(Box::new(writer));
@@ -191,32 +191,38 @@ pub fn summary(prepared: &mut Prepared) -> ModelSummary {
         );
     }
     ModelSummary {
-        name: prepared.name.clone(),
+        name: prepared.facts().name.clone(),
         points,
         interactions,
         inputs,
         outputs,
         params,
-        macros: prepared.macros.clone(),
-        macro_units: prepared.macro_units.clone(),
+        macros: prepared.facts().macros.clone(),
+        macro_units: prepared.facts().macro_units.clone(),
         stability,
-        reference_pitch_hz: prepared.settings.reference_pitch_hz,
-        reference_key: prepared.settings.reference_key,
-        declared_voices: prepared.settings.voices,
+        reference_pitch_hz: prepared.facts().settings.reference_pitch_hz,
+        reference_key: prepared.facts().settings.reference_key,
+        declared_voices: prepared.facts().settings.voices,
         voices: prepared.voices(),
-        playing: match prepared.conventions {
+        playing: match prepared.facts().conventions {
             instrument::Conventions::Musical => Playing::Musical,
             instrument::Conventions::Legacy => Playing::Legacy,
         },
-        unpitched: prepared.settings.unpitched,
+        unpitched: prepared.facts().settings.unpitched,
         highest_key: prepared.highest_key(),
-        output_trim_db: 20.0 * prepared.output_trim.log10(),
-        input_trim_db: 20.0 * prepared.input_trim.log10(),
+        output_trim_db: 20.0 * prepared.facts().output_trim.log10(),
+        input_trim_db: 20.0 * prepared.facts().input_trim.log10(),
         exciters: prepared
+            .facts()
             .exciters
             .iter()
             .map(|x| format!("{} in{}", x.kind.name(), x.input + 1))
-            .chain(prepared.note_input.map(|k| format!("strike in{}", k + 1)))
+            .chain(
+                prepared
+                    .facts()
+                    .note_input
+                    .map(|k| format!("strike in{}", k + 1)),
+            )
             .collect(),
     }
 }

@@ -115,7 +115,7 @@ mod tests {
         store.apply_voices();
         assert_eq!(store.generation(), generation, "prepared again");
         let model = store.receive().expect("the loaded model");
-        assert_eq!((model.name.as_str(), model.voices()), ("loaded", 8));
+        assert_eq!((model.facts().name.as_str(), model.voices()), ("loaded", 8));
         // A script that does not compile leaves the setting to be applied to the running one.
         store.set_voices(3);
         assert!(store.submit(script("broken", f64::NAN)).is_err());
@@ -145,7 +145,7 @@ mod tests {
                 last = Some(m);
             }
             if let Some(m) = last {
-                assert_eq!(m.name, name, "round {round}");
+                assert_eq!(m.facts().name, name, "round {round}");
             }
             assert_eq!(store.running().name, name, "round {round}");
         }

@@ -13,15 +13,15 @@ fn every_preset_prepares_at_every_common_rate() {
         for sr in [44_100.0, 48_000.0, 96_000.0] {
             let p = prepare(preset.id, preset.text, sr)
                 .unwrap_or_else(|e| panic!("{} at {sr}: {e}", preset.id));
-            assert_eq!(p.inputs.len(), p.roles.len() * CHUNK);
+            assert_eq!(p.inputs.len(), p.facts().roles.len() * CHUNK);
             assert!(p.outputs.len() >= CHUNK);
             assert!(
-                !p.envelope.lines.is_empty(),
+                !p.facts().envelope.lines.is_empty(),
                 "{}: no stability lines",
                 preset.id
             );
             // The clamp accepts every preset as written.
-            let (gk, gz, clamped) = p.envelope.clamp(1.0, 1.0, 1.0);
+            let (gk, gz, clamped) = p.facts().envelope.clamp(1.0, 1.0, 1.0);
             assert!(
                 !clamped && gk == 1.0 && gz == 1.0,
                 "{} clamped at unit gains",
@@ -51,10 +51,10 @@ const NEGATIVE_SPRINGS: [&str; 1] = ["felt-piano"];
 fn the_stiffness_limit_matches_the_stability_analysis() {
     for preset in PRESETS {
         let mut p = prepare(preset.id, preset.text, 48_000.0).unwrap();
-        let limit = p.envelope.max_stiffness(1.0);
+        let limit = p.facts().envelope.max_stiffness(1.0);
         assert!(limit.is_finite() && limit > 0.0, "{}: {limit}", preset.id);
         // The limits hold for a key held down: a bow's friction at its pressed value.
-        let exciters = p.exciters.clone();
+        let exciters = p.facts().exciters.clone();
         ressort_engine::instrument::prepare::press_audio_params(&mut p.engine, &exciters);
         let gershgorin = ressort_engine::analysis::envelope::envelope(&mut p.engine);
         let bound = gershgorin.max_stiffness(1.0);
@@ -91,7 +91,7 @@ fn the_stiffness_limit_matches_the_stability_analysis() {
                     .fold(0.0, f64::max);
                 assert!(
                     (worst - STABILITY_HEADROOM).abs() < 1e-9
-                        || (limit <= 1.0 + 1e-9 && worst <= p.worst_load.0 + 1e-9),
+                        || (limit <= 1.0 + 1e-9 && worst <= p.facts().worst_load.0 + 1e-9),
                     "{} at ×{limit}: worst coupled load {worst}",
                     preset.id
                 );
@@ -111,20 +111,20 @@ fn the_stiffness_limit_matches_the_stability_analysis() {
 fn clamped_gains_keep_every_preset_running() {
     for preset in PRESETS {
         let mut p = prepare(preset.id, preset.text, 48_000.0).unwrap();
-        let (gk, gz, clamped) = p.envelope.clamp(16.0, 16.0, 1.0);
+        let (gk, gz, clamped) = p.facts().envelope.clamp(16.0, 16.0, 1.0);
         println!(
             "{:<20} ×16/×16 requested → stiffness ×{gk:.3}, damping ×{gz:.3} (clamped {clamped})",
             preset.id
         );
         p.engine.set_class_gain(ScaleClass::Stiffness, gk);
         p.engine.set_class_gain(ScaleClass::Damping, gz);
-        let n_in = p.roles.len();
+        let n_in = p.facts().roles.len();
         let n_out = p.outputs.len() / CHUNK;
         let mut peak: f64 = 0.0;
         for block in 0..(48_000 / CHUNK) {
             p.inputs.fill(0.0);
             if block == 0 {
-                if let Some(k) = p.note_input {
+                if let Some(k) = p.facts().note_input {
                     p.inputs[k * CHUNK] = -0.05;
                 }
             }
@@ -155,9 +155,9 @@ fn macro_slots_bind_params_in_declaration_order() {
     let text = "@K param 0.1\n@Z param 0.001\n@m mass 1 0 0\n@g ground 0\n\
                 @s springDamper @m @g K Z\n@in1 frcInput @m\n@out1 posOutput @m\n";
     let p = prepare("test", text, 48_000.0).unwrap();
-    let k = p.macros[0].as_ref().expect("slot 1 bound");
-    let z = p.macros[1].as_ref().expect("slot 2 bound");
-    assert!(p.macros[2..].iter().all(Option::is_none));
+    let k = p.facts().macros[0].as_ref().expect("slot 1 bound");
+    let z = p.facts().macros[1].as_ref().expect("slot 2 bound");
+    assert!(p.facts().macros[2..].iter().all(Option::is_none));
     assert_eq!((k.name.as_str(), z.name.as_str()), ("K", "Z"));
     // The declared value sits in the middle; the ends are the range.
     assert!((k.value_at(0.5) - 0.1).abs() < 1e-12);
@@ -175,7 +175,7 @@ fn macro_ranges_stop_where_the_model_would_explode() {
     let text = "@K param 3\n@m mass 1 0 0\n@g ground 0\n@s spring @m @g K\n\
                 @in1 frcInput @m\n@out1 posOutput @m\n";
     let p = prepare("test", text, 44_100.0).unwrap();
-    let k = p.macros[0].as_ref().unwrap();
+    let k = p.facts().macros[0].as_ref().unwrap();
     assert!(k.max < 4.0 && k.max > 3.0, "max {}", k.max);
     println!("K = 3 on M = 1: macro range {}..{}", k.min, k.max);
 }
@@ -211,7 +211,7 @@ fn the_estimated_reference_pitch_of_an_oscillator_matches_the_closed_form() {
         let p = prepare("osc", text, sr).unwrap();
         let k = 0.01 * (44_100.0 / sr) * (44_100.0f64 / sr);
         let exact = (k / 4.0).sqrt().asin() * sr / std::f64::consts::PI;
-        let got = p.settings.reference_pitch_hz.expect("a pitch");
+        let got = p.facts().settings.reference_pitch_hz.expect("a pitch");
         let cents = 1200.0 * (got / exact).log2();
         println!(
             "osc K=0.01 at {sr} Hz: estimated {got:.3} Hz, exact {exact:.3} Hz ({cents:+.2} cents)"
@@ -247,20 +247,20 @@ fn host_directives_configure_the_plugin() {
                 @in3 posInput 0.5\n@c contact @in3 @o 0.01 0 0\n@out1 posOutput @o\n\
                 ~pitch 440\n~key 69\n~note in2 -0.1\n~route in1 sidechain_right\n~macro K 0.05 0.2\n";
     let p = prepare("t", text, 48_000.0).unwrap();
-    assert_eq!(p.note_input, Some(1));
-    assert_eq!(p.settings.note_force, -0.1);
-    assert_eq!(p.settings.reference_pitch_hz, Some(440.0));
-    assert_eq!(p.settings.reference_key, 69.0);
+    assert_eq!(p.facts().note_input, Some(1));
+    assert_eq!(p.facts().settings.note_force, -0.1);
+    assert_eq!(p.facts().settings.reference_pitch_hz, Some(440.0));
+    assert_eq!(p.facts().settings.reference_key, 69.0);
     assert_eq!(
-        p.routing,
+        p.facts().routing,
         vec![
             Some(ressort_engine::RouteSource::SidechainRight),
             None,
             None
         ]
     );
-    assert_eq!(p.rest, vec![0.0, 0.0, 0.5]);
-    let k = p.macros[0].as_ref().unwrap();
+    assert_eq!(p.facts().rest, vec![0.0, 0.0, 0.5]);
+    let k = p.facts().macros[0].as_ref().unwrap();
     assert_eq!((k.min, k.max), (0.05, 0.2));
 
     let bad = text.replace("~note in2 -0.1", "~note in3");
@@ -287,9 +287,9 @@ fn every_preset_moves_its_first_output_when_played() {
     let mut silent = Vec::new();
     for preset in PRESETS {
         let p = prepare(preset.id, preset.text, SR).unwrap();
-        let played = p.note_input.is_some() || !p.exciters.is_empty();
+        let played = p.facts().note_input.is_some() || !p.facts().exciters.is_empty();
         // The output stage's own gain, so that the peak reads in the model's units.
-        let trim = p.output_trim;
+        let trim = p.facts().output_trim;
         let controls = Controls {
             dc_filter: false,
             output_db: -60.0,
@@ -351,6 +351,7 @@ fn chladni_listening_point_is_a_macro_knob() {
     let render = |lx_slot: Option<f64>| {
         let mut p = prepare(preset.id, preset.text, 48_000.0).unwrap();
         let names: Vec<&str> = p
+            .facts()
             .macros
             .iter()
             .map(|b| b.as_ref().map_or("", |b| b.name.as_str()))
@@ -371,17 +372,17 @@ fn chladni_listening_point_is_a_macro_knob() {
                 "pM"
             ]
         );
-        let lx = p.macros[6].clone().unwrap();
-        let ly = p.macros[7].as_ref().unwrap();
+        let lx = p.facts().macros[6].clone().unwrap();
+        let ly = p.facts().macros[7].as_ref().unwrap();
         assert_eq!((lx.min, lx.default, lx.max), (0.0, 0.3, 1.0));
         assert_eq!((ly.min, ly.default, ly.max), (0.0, 0.6, 1.0));
         if let Some(n) = lx_slot {
             p.engine.set_param(lx.param, lx.value_at(n)).unwrap();
         }
-        let n_in = p.roles.len();
+        let n_in = p.facts().roles.len();
         let n_out = p.outputs.len() / CHUNK;
-        let k = p.note_input.expect("a note input");
-        let strike = p.settings.note_force * p.strike_scale;
+        let k = p.facts().note_input.expect("a note input");
+        let strike = p.facts().settings.note_force * p.facts().strike_scale;
         let mut out1 = Vec::with_capacity(FRAMES);
         for block in 0..FRAMES / CHUNK {
             p.inputs.fill(0.0);

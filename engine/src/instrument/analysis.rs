@@ -43,12 +43,12 @@ impl ModalModel {
         let info = prepared.engine.info();
         ModalModel {
             engine: prepared.engine.clone(),
-            sample_rate: prepared.sample_rate,
-            reference_pitch_hz: prepared.settings.reference_pitch_hz,
-            envelope: prepared.envelope.clone(),
-            macros: prepared.macros.clone(),
-            macro_envelopes: prepared.macro_envelopes.clone(),
-            note_input: prepared.note_input.map(|i| i + 1),
+            sample_rate: prepared.facts.sample_rate,
+            reference_pitch_hz: prepared.facts.settings.reference_pitch_hz,
+            envelope: prepared.facts.envelope.clone(),
+            macros: prepared.facts.macros.clone(),
+            macro_envelopes: prepared.facts.macro_envelopes.clone(),
+            note_input: prepared.facts.note_input.map(|i| i + 1),
             num_inputs: info.inputs.len(),
             num_outputs: info.outputs.len(),
         }

@@ -226,7 +226,7 @@ impl Smoothed {
     /// from the reference key in semitones.
     pub fn apply(&self, model: &mut Prepared, note_st: f64) -> Gains {
         let gains = self.gains(&ClampView::of(model), note_st, 1.0);
-        self.set(&mut model.engine, &model.macros, &gains);
+        self.set(&mut model.engine, &model.facts.macros, &gains);
         gains
     }
 
@@ -348,11 +348,11 @@ pub struct ClampView<'a> {
 impl<'a> ClampView<'a> {
     pub fn of(m: &'a Prepared) -> ClampView<'a> {
         ClampView {
-            reference_pitch_hz: m.settings.reference_pitch_hz,
-            sample_rate: m.sample_rate,
-            envelope: &m.envelope,
-            macros: &m.macros,
-            macro_envelopes: &m.macro_envelopes,
+            reference_pitch_hz: m.facts.settings.reference_pitch_hz,
+            sample_rate: m.facts.sample_rate,
+            envelope: &m.facts.envelope,
+            macros: &m.facts.macros,
+            macro_envelopes: &m.facts.macro_envelopes,
         }
     }
 }

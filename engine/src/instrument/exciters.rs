@@ -31,7 +31,7 @@
 //! `@nlZ audioParam @in5`. Nothing here allocates: a voice keeps one [`Gesture`] per exciter
 //! in place.
 
-use super::prepare::{InputRole, Rejected};
+use super::host::{InputRole, Rejected};
 use crate::laws::LawKind;
 use crate::{ElementKind, Engine, ParamKind};
 use crate::{Endpoint, ExciterKind, ModelSpec, SampleRateMode, REFERENCE_SAMPLE_RATE_HZ};

@@ -2,6 +2,7 @@
 //! the reference pitch and key, and macro ranges.
 
 use crate::{ExciterKind, MacroRange, ModelSpec, RouteSource};
+use std::fmt;
 
 /// The default order: `@in1`, `@in2`… take the main input's left and right channels when
 /// the plugin has a main input (effect layouts), then the sidechain's channels 1 … 8.
@@ -124,3 +125,28 @@ impl HostSettings {
         })
     }
 }
+
+/// What a model input carries, which decides its gain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputRole {
+    /// A `frcInput`: × Force gain.
+    Force,
+    /// A `posInput`: × Position gain.
+    Position,
+    /// An `audioParam`: the raw channel.
+    AudioParam,
+    /// Declared by no element.
+    Unused,
+}
+
+/// Why a script did not become the running model: `LINE:COL: error: …` lines.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rejected(pub Vec<String>);
+
+impl fmt::Display for Rejected {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0.join("\n"))
+    }
+}
+
+impl std::error::Error for Rejected {}

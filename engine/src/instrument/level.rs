@@ -34,8 +34,8 @@ use super::{Instrument, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS};
 
 /// Where the automatic trim puts a C4 note at velocity 0.8.
 pub const TARGET_DBFS: f64 = -12.0;
-/// The note the level is measured with.
-pub const MEASURE_KEY: u8 = 60;
+/// The note the level is measured with: the home key of a pitched model.
+pub const MEASURE_KEY: u8 = super::prepare::HOME_KEY;
 pub const MEASURE_VELOCITY: f32 = 0.8;
 /// The peak of the reference drum hits.
 pub const REFERENCE_DRUM_DBFS: f64 = -6.0;
@@ -57,10 +57,10 @@ const SILENT: f64 = 1e-12;
 /// Measures the model's rest outputs, note level and drum level, and sets its trims.
 pub fn calibrate(p: Prepared) -> Prepared {
     let mut p = p;
-    p.rest_out = rest_outputs(&mut p);
+    p.facts_mut().rest_out = rest_outputs(&mut p);
     let size = (p.engine.info().num_points + p.engine.info().num_interactions).max(1) as f64;
     let budget = (WORK_BUDGET / size).max(1.0);
-    let sr = p.sample_rate;
+    let sr = p.facts.sample_rate;
     let note_frames = (SECONDS * sr).min(budget) as usize;
     // A kick lasts about 0.3 s: its window is not shortened below a quarter second.
     let drum_frames = (DRUM_SECONDS * sr).min(budget.max(0.25 * sr)) as usize;
@@ -84,8 +84,8 @@ pub fn calibrate(p: Prepared) -> Prepared {
     } else {
         (1.0, 1.0)
     };
-    p3.output_trim = output.clamp(OUTPUT_TRIM_RANGE.0, OUTPUT_TRIM_RANGE.1);
-    p3.input_trim = input.clamp(INPUT_TRIM_RANGE.0, INPUT_TRIM_RANGE.1);
+    p3.facts_mut().output_trim = output.clamp(OUTPUT_TRIM_RANGE.0, OUTPUT_TRIM_RANGE.1);
+    p3.facts_mut().input_trim = input.clamp(INPUT_TRIM_RANGE.0, INPUT_TRIM_RANGE.1);
     if note > SILENT && drum > SILENT {
         p3 = refine_input_trim(p3, note, drum_frames, mask);
     }
@@ -102,15 +102,15 @@ pub fn calibrate(p: Prepared) -> Prepared {
 /// [`HOT_DB`], the loudest quieter one otherwise.
 fn refine_input_trim(p: Prepared, note: f64, frames: usize, mask: u16) -> Prepared {
     let mut p = p;
-    let output = p.output_trim;
-    p.output_trim = 1.0;
-    let kick = kick(frames, p.sample_rate);
+    let output = p.facts.output_trim;
+    p.facts_mut().output_trim = 1.0;
+    let kick = kick(frames, p.facts.sample_rate);
     let (mut lo, mut hi): (Option<f64>, Option<f64>) = (None, None);
     // (trim, dB off the note) of every render.
     let mut tried: Vec<(f64, f64)> = Vec::new();
-    let mut t = p.input_trim;
+    let mut t = p.facts.input_trim;
     for _ in 0..REFINE_PASSES {
-        p.input_trim = t;
+        p.facts_mut().input_trim = t;
         let (back, drum) = peak(p, frames, false, Some((&kick, mask)));
         p = back;
         // Aimed a little above the note: where a hammer stands in between, a kick a little
@@ -148,9 +148,9 @@ fn refine_input_trim(p: Prepared, note: f64, frames: usize, mask: u16) -> Prepar
                 .filter(|(_, off)| *off <= 0.0)
                 .max_by(|a, b| a.1.total_cmp(&b.1))
         })
-        .map_or(p.input_trim, |(t, _)| *t);
-    p.input_trim = keep;
-    p.output_trim = output;
+        .map_or(p.facts.input_trim, |(t, _)| *t);
+    p.facts_mut().input_trim = keep;
+    p.facts_mut().output_trim = output;
     p
 }
 
@@ -165,10 +165,10 @@ const AIM_DB: f64 = 2.0;
 
 /// Each output's value after one step from rest with every input at rest.
 fn rest_outputs(p: &mut Prepared) -> Vec<f64> {
-    let n_in = p.roles.len();
-    let n_out = p.num_outputs;
+    let n_in = p.facts.roles.len();
+    let n_out = p.facts.num_outputs;
     let mut inputs = vec![0.0; n_in];
-    inputs.copy_from_slice(&p.rest[..n_in]);
+    inputs.copy_from_slice(&p.facts.rest[..n_in]);
     let mut outputs = vec![0.0; n_out.max(1)];
     p.engine.process(1, &inputs, &mut outputs[..n_out]);
     let tripped = p.engine.is_tripped();
@@ -184,7 +184,7 @@ fn rest_outputs(p: &mut Prepared) -> Vec<f64> {
 /// inputs), and returns it at rest with the peak of its outputs (the main pair and the
 /// auxiliary ones) at unit gain.
 fn peak(p: Prepared, frames: usize, note: bool, drum: Option<(&[f32], u16)>) -> (Prepared, f64) {
-    let sr = p.sample_rate;
+    let sr = p.facts.sample_rate;
     let controls = Controls {
         output_db: MEASURE_GAIN_DB,
         ..Controls::DEFAULT
@@ -193,7 +193,7 @@ fn peak(p: Prepared, frames: usize, note: bool, drum: Option<(&[f32], u16)>) -> 
     inst.set_model(Box::new(p));
     const BLOCK: usize = 256;
     // Every output the host can hear: the main pair and the auxiliary ones.
-    let channels = match inst.model().map_or(1, |m| m.num_outputs) {
+    let channels = match inst.model().map_or(1, |m| m.facts.num_outputs) {
         0..=2 => 2,
         n => n.min(MAX_HOST_OUTPUTS).div_ceil(2) * 2,
     };
@@ -237,10 +237,10 @@ fn peak(p: Prepared, frames: usize, note: bool, drum: Option<(&[f32], u16)>) -> 
     // points back.
     p.engine.set_class_gain(crate::ScaleClass::Stiffness, 1.0);
     p.engine.set_class_gain(crate::ScaleClass::Damping, 1.0);
-    let n_in = p.roles.len();
+    let n_in = p.facts.roles.len();
     let mut rest = vec![0.0; n_in];
-    rest.copy_from_slice(&p.rest[..n_in]);
-    let mut outputs = vec![0.0; p.num_outputs];
+    rest.copy_from_slice(&p.facts.rest[..n_in]);
+    let mut outputs = vec![0.0; p.facts.num_outputs];
     p.engine.process(1, &rest, &mut outputs);
     p.engine.reset();
     p.rest_gestures();

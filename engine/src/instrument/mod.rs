@@ -28,6 +28,7 @@ pub mod exciters;
 pub mod gains;
 pub mod host;
 pub mod level;
+mod load;
 pub mod macros;
 pub mod output;
 pub mod prepare;
@@ -40,12 +41,10 @@ pub use analysis::{ModalModel, ModesAtControls};
 pub use controls::Controls;
 pub use events::{Event, Timed};
 pub use gains::Gains;
-pub use host::HostSettings;
+pub use host::{HostSettings, InputRole, Rejected};
+pub use load::{prepare, prepare_with};
 pub use macros::MacroBinding;
-pub use prepare::{
-    parse_script, peak_frequency, prepare, prepare_with, Conventions, InputRole, Prepared,
-    Rejected, Watcher,
-};
+pub use prepare::{parse_script, peak_frequency, Conventions, Facts, Prepared, Watcher};
 
 use crate::RouteSource;
 use controls::{ClampView, Smoothed};
@@ -75,11 +74,11 @@ pub const MAX_HOST_OUTPUTS: usize = 8;
 macro_rules! clamp_view {
     ($m:expr) => {
         ClampView {
-            reference_pitch_hz: $m.settings.reference_pitch_hz,
-            sample_rate: $m.sample_rate,
-            envelope: &$m.envelope,
-            macros: &$m.macros,
-            macro_envelopes: &$m.macro_envelopes,
+            reference_pitch_hz: $m.facts.settings.reference_pitch_hz,
+            sample_rate: $m.facts.sample_rate,
+            envelope: &$m.facts.envelope,
+            macros: &$m.facts.macros,
+            macro_envelopes: &$m.facts.macro_envelopes,
         }
     };
 }
@@ -92,11 +91,11 @@ use expression::{tune_voice, SharedGains};
 /// that feed its force and position inputs, by the script's `~route`s, else in `order`.
 pub(crate) fn pushing_channels(m: &Prepared, order: &[RouteSource]) -> u16 {
     let mut mask = 0u16;
-    for (k, role) in m.roles.iter().enumerate() {
+    for (k, role) in m.facts.roles.iter().enumerate() {
         if !matches!(role, InputRole::Force | InputRole::Position) {
             continue;
         }
-        let source = m.routing[k].or_else(|| order.get(k).copied());
+        let source = m.facts.routing[k].or_else(|| order.get(k).copied());
         if let Some(c) = source.and_then(host::channel) {
             mask |= 1 << c;
         }
@@ -107,11 +106,11 @@ pub(crate) fn pushing_channels(m: &Prepared, order: &[RouteSource]) -> u16 {
 /// The host channels ([`host::channel`] numbering, as bits) that feed any input of `m`.
 pub(crate) fn fed_channels(m: &Prepared, order: &[RouteSource]) -> u16 {
     let mut mask = 0u16;
-    for (k, role) in m.roles.iter().enumerate() {
+    for (k, role) in m.facts.roles.iter().enumerate() {
         if *role == InputRole::Unused {
             continue;
         }
-        let source = m.routing[k].or_else(|| order.get(k).copied());
+        let source = m.facts.routing[k].or_else(|| order.get(k).copied());
         if let Some(c) = source.and_then(host::channel) {
             mask |= 1 << c;
         }
@@ -370,10 +369,10 @@ impl Instrument {
             return;
         };
         // The model itself, which the host's audio plays (with voices), sits at its home key.
-        let home_st = m.home_key() - m.settings.reference_key;
+        let home_st = m.home_key() - m.facts.settings.reference_key;
         let Some(bank) = m.bank.as_mut() else {
             let key = self.note_key.map_or(m.home_key(), f64::from);
-            let note_st = key - m.settings.reference_key;
+            let note_st = key - m.facts.settings.reference_key;
             self.gains = self.smoothed.apply(m, note_st + self.tuning_st);
             return;
         };
@@ -539,7 +538,7 @@ impl Instrument {
                         let response =
                             events::velocity_response(velocity, self.controls.velocity_exponent);
                         if let Some(m) = self.current.as_deref_mut() {
-                            let note_st = note as f64 - m.settings.reference_key;
+                            let note_st = note as f64 - m.facts.settings.reference_key;
                             if let Some(bank) = m.bank.as_mut() {
                                 // A voice of its own, tuned before its first sample.
                                 let i = bank.note_on(note, channel, voice_id, note_st, response);
@@ -556,7 +555,7 @@ impl Instrument {
                                 // The one model's exciters follow the newest key.
                                 m.held_note = Some((note, channel));
                                 m.strike_hold = 0;
-                                exciters::start(&mut m.gestures, &m.exciters, response);
+                                exciters::start(&mut m.gestures, &m.facts.exciters, response);
                             }
                         } else {
                             strike += response;
@@ -575,7 +574,7 @@ impl Instrument {
                         let response = events::velocity_response(velocity, 1.0);
                         let bank = self.current.as_deref_mut().and_then(|m| {
                             let key = m.home_key().round().clamp(0.0, 127.0) as u8;
-                            let note_st = key as f64 - m.settings.reference_key;
+                            let note_st = key as f64 - m.facts.settings.reference_key;
                             m.bank.as_mut().map(|b| (b, key, note_st))
                         });
                         let hold = (exciters::STRIKE_HOLD_MS * 1e-3 * self.sample_rate) as u64;
@@ -590,9 +589,13 @@ impl Instrument {
                             None => {
                                 strike += response;
                                 if let Some(m) = self.current.as_deref_mut() {
-                                    if m.held_note.is_none() && !m.exciters.is_empty() {
+                                    if m.held_note.is_none() && !m.facts.exciters.is_empty() {
                                         m.strike_hold = hold.max(1);
-                                        exciters::start(&mut m.gestures, &m.exciters, response);
+                                        exciters::start(
+                                            &mut m.gestures,
+                                            &m.facts.exciters,
+                                            response,
+                                        );
                                     }
                                 }
                             }
@@ -692,7 +695,7 @@ impl Instrument {
         if let Some(m) = self.current.as_deref_mut() {
             let fed = m.fill_inputs(&self.host_in, self.order, len, force, position, trigger);
             m.awake |= fed || self.pressure != 0.0;
-            let n_in = m.roles.len();
+            let n_in = m.facts.roles.len();
             let n_out = m.outputs.len() / CHUNK;
             // Pressure: a sustained push on the script's `~pressure` input.
             let pressure = m.pressure_gain(force, position);
@@ -706,12 +709,12 @@ impl Instrument {
             }
             let strike_force = m.strike_force(force);
             let drive = Drive {
-                note_input: m.note_input,
+                note_input: m.facts.note_input,
                 strike_force,
                 pressure,
-                exciters: &m.exciters,
-                force: force * m.force_scale,
-                rest_out: &m.rest_out,
+                exciters: &m.facts.exciters,
+                force: force * m.facts.force_scale,
+                rest_out: &m.facts.rest_out,
             };
             if let Some(bank) = m.bank.as_mut() {
                 // The model itself keeps playing what the host feeds it (a sidechain strikes
@@ -725,7 +728,7 @@ impl Instrument {
                     );
                     tripped |= r.tripped;
                 } else {
-                    for (c, &r) in m.rest_out.iter().enumerate().take(n_out) {
+                    for (c, &r) in m.facts.rest_out.iter().enumerate().take(n_out) {
                         m.outputs[c * len..(c + 1) * len].fill(r);
                     }
                 }
@@ -747,15 +750,15 @@ impl Instrument {
                 if strike > 0.0 {
                     m.strike(0, len, strike, force);
                 }
-                if !m.exciters.is_empty() {
+                if !m.facts.exciters.is_empty() {
                     let held = m.held_note.is_some() || m.strike_hold > 0;
                     m.strike_hold = m.strike_hold.saturating_sub(len as u64);
                     exciters::play(
                         &mut m.gestures,
-                        &m.exciters,
+                        &m.facts.exciters,
                         held,
                         self.pressure,
-                        force * m.force_scale,
+                        force * m.facts.force_scale,
                         &mut m.inputs[..n_in * len],
                         len,
                         1,
@@ -778,7 +781,7 @@ impl Instrument {
                 && m.bank.as_ref().is_none_or(|b| b.sounding() == 0)
         });
         if let Some(old) = self.outgoing.as_deref_mut() {
-            let n_in = old.roles.len();
+            let n_in = old.facts.roles.len();
             let n_out = old.outputs.len() / CHUNK;
             old.inputs[..n_in * len].fill(0.0);
             old.engine.process(
@@ -788,7 +791,7 @@ impl Instrument {
             );
             if let Some(bank) = old.bank.as_mut() {
                 let drive = Drive {
-                    rest_out: &old.rest_out,
+                    rest_out: &old.facts.rest_out,
                     ..Drive::NONE
                 };
                 bank.process(

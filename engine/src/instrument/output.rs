@@ -24,10 +24,14 @@ pub(super) struct OutputStage {
 /// taken off the model's rest output and trimmed ([`super::level`]).
 #[inline]
 pub(super) fn model_channel(m: &Prepared, c: usize, i: usize, len: usize) -> f64 {
-    let k = if c == 1 && m.num_outputs == 1 { 0 } else { c };
-    if k < m.num_outputs {
+    let k = if c == 1 && m.facts.num_outputs == 1 {
+        0
+    } else {
+        c
+    };
+    if k < m.facts.num_outputs {
         // Off its rest value, through the automatic trim (0 and 1 in legacy projects).
-        (m.outputs[k * len + i] - m.rest_out[k]) * m.output_trim
+        (m.outputs[k * len + i] - m.facts.rest_out[k]) * m.facts.output_trim
     } else {
         0.0
     }

@@ -4,7 +4,7 @@
 //! buffers). The audio thread then only runs a [`Prepared`] model.
 
 use super::exciters::{self, Exciter, Gestures};
-use super::host::HostSettings;
+use super::host::{HostSettings, InputRole, Rejected};
 use super::macros::{macro_bindings, MacroBinding};
 use super::units::{unit_of, MacroUnit};
 use super::voices::VoiceBank;
@@ -18,19 +18,7 @@ use crate::{
     RouteSource, SampleRateMode, Span, REFERENCE_SAMPLE_RATE_HZ,
 };
 use std::fmt;
-
-/// What a model input carries, which decides its gain.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum InputRole {
-    /// A `frcInput`: × Force gain.
-    Force,
-    /// A `posInput`: × Position gain.
-    Position,
-    /// An `audioParam`: the raw channel.
-    AudioParam,
-    /// Declared by no element.
-    Unused,
-}
+use std::sync::Arc;
 
 /// Something that watches a running model's positions once per chunk (the plugin's motion
 /// view). It runs on the audio thread: it must not allocate, lock or block.
@@ -39,17 +27,18 @@ pub trait Watcher: Send + fmt::Debug {
     fn tick(&mut self, frames: usize, positions: &[f64], watching: bool);
 }
 
-/// A model ready to run: compiled for one sample rate, with its scratch buffers.
-#[derive(Debug)]
-pub struct Prepared {
-    pub engine: Engine,
+/// The key a pitched model sits at before any note, in concert pitch: C4, where its level is
+/// measured ([`super::level::MEASURE_KEY`]).
+pub const HOME_KEY: u8 = 60;
+
+/// What preparing a model found: fixed for the life of a [`Prepared`] model (its running
+/// copies share it) and read by the audio path, the editor and the host. Only the level
+/// calibration writes it, while the model is being prepared.
+#[derive(Clone, Debug)]
+pub struct Facts {
     pub sample_rate: f64,
     pub name: String,
     pub settings: HostSettings,
-    /// Planar input scratch, `roles.len()` channels of [`CHUNK`] samples.
-    pub inputs: Vec<f64>,
-    /// Planar output scratch, `max(outputs, 1)` channels of [`CHUNK`] samples.
-    pub outputs: Vec<f64>,
     pub num_outputs: usize,
     /// One entry per model input channel (`@in1` first).
     pub roles: Vec<InputRole>,
@@ -70,24 +59,15 @@ pub struct Prepared {
     pub macros: Vec<Option<MacroBinding>>,
     /// How each macro slot reads (Hz, T60, ratio, 0 … 1 or its value), by slot.
     pub macro_units: Vec<MacroUnit>,
+    /// The limits of the host's Stiffness and Damping gains.
     pub envelope: StabilityEnvelope,
     /// Per macro slot: the envelopes with its param at the range's minimum and maximum (the
     /// others at their declared values).
     pub macro_envelopes: Vec<Option<(StabilityEnvelope, StabilityEnvelope)>>,
     /// Loads at unit gains: (worst load, label of the worst mass or structure).
     pub worst_load: (f64, String),
-    /// Sees the positions after every chunk, if set.
-    pub watcher: Option<Box<dyn Watcher>>,
-    /// The voices when the model plays polyphonically ([`Prepared::set_voices`]); without
-    /// them `engine` is the one voice, and a note retunes it.
-    pub bank: Option<VoiceBank>,
     /// The exciters a key plays besides its strike (`~exciter`, [`super::exciters`]).
     pub exciters: Vec<Exciter>,
-    /// The one model's gestures (without voices), the key that holds them (note, channel),
-    /// and the samples a strike without a key still holds them.
-    pub gestures: Gestures,
-    pub held_note: Option<(u8, u8)>,
-    pub strike_hold: u64,
     /// How the model is played: concert pitch and the automatic trims, or as projects saved
     /// before them.
     pub conventions: Conventions,
@@ -101,23 +81,33 @@ pub struct Prepared {
     /// ([`super::level`]); 1 in legacy projects.
     pub output_trim: f64,
     pub input_trim: f64,
+}
+
+/// A model ready to run: what its preparation found ([`Facts`], immutable) and the running
+/// part: the engine, its voices, the gestures keys hold, and scratch buffers.
+#[derive(Debug)]
+pub struct Prepared {
+    pub(crate) facts: Arc<Facts>,
+    pub engine: Engine,
+    /// Planar input scratch, `roles.len()` channels of [`CHUNK`] samples.
+    pub inputs: Vec<f64>,
+    /// Planar output scratch, `max(outputs, 1)` channels of [`CHUNK`] samples.
+    pub outputs: Vec<f64>,
+    /// Sees the positions after every chunk, if set.
+    pub watcher: Option<Box<dyn Watcher>>,
+    /// The voices when the model plays polyphonically ([`Prepared::set_voices`]); without
+    /// them `engine` is the one voice, and a note retunes it.
+    pub bank: Option<VoiceBank>,
+    /// The one model's gestures (without voices), the key that holds them (note, channel),
+    /// and the samples a strike without a key still holds them.
+    pub gestures: Gestures,
+    pub held_note: Option<(u8, u8)>,
+    pub strike_hold: u64,
     /// With voices, the model itself plays only what the host feeds it: under today's
     /// conventions it is not run until a host signal or pressure reaches it (a model that
     /// moves by itself, a ball dropped at every reset, would otherwise sound at load).
     pub awake: bool,
 }
-
-/// Why a script did not become the running model: `LINE:COL: error: …` lines.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Rejected(pub Vec<String>);
-
-impl fmt::Display for Rejected {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0.join("\n"))
-    }
-}
-
-impl std::error::Error for Rejected {}
 
 /// Parses a script and turns every error into a `LINE:COL: error: …` line. Warnings are kept
 /// too, after the errors, when the script is accepted.
@@ -147,13 +137,10 @@ pub enum Conventions {
     Legacy,
 }
 
-/// Compiles a script for a sample rate and derives everything the audio thread needs.
-pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rejected> {
-    prepare_with(name, text, sample_rate, Conventions::Musical)
-}
-
-/// [`prepare`] under the given playing conventions.
-pub fn prepare_with(
+/// Compiles a script for a sample rate and derives everything the audio thread needs, under
+/// the given playing conventions; the level calibration ([`super::level`]) comes after, in
+/// [`super::load`].
+pub(crate) fn prepare_uncalibrated(
     name: &str,
     text: &str,
     sample_rate: f64,
@@ -267,22 +254,13 @@ pub fn prepare_with(
         SampleRateMode::Raw => 1.0,
     };
     let num_outputs = info.num_outputs();
-    let mut prepared = Prepared {
-        watcher: None,
-        bank: None,
+    let facts = Facts {
         exciters,
-        gestures: exciters::AT_REST,
-        held_note: None,
-        strike_hold: 0,
         conventions,
         rest_out: vec![0.0; num_outputs.max(1)],
         output_trim: 1.0,
         input_trim: 1.0,
-        awake: conventions == Conventions::Legacy,
-        inputs: vec![0.0; roles.len() * CHUNK],
-        outputs: vec![0.0; num_outputs.max(1) * CHUNK],
         num_outputs,
-        roles,
         routing,
         rest,
         note_input,
@@ -296,11 +274,20 @@ pub fn prepare_with(
         settings,
         sample_rate,
         name: name.to_string(),
+        roles,
+    };
+    let prepared = Prepared {
+        watcher: None,
+        bank: None,
+        gestures: exciters::AT_REST,
+        held_note: None,
+        strike_hold: 0,
+        awake: conventions == Conventions::Legacy,
+        inputs: vec![0.0; facts.roles.len() * CHUNK],
+        outputs: vec![0.0; num_outputs.max(1) * CHUNK],
+        facts: Arc::new(facts),
         engine,
     };
-    if conventions == Conventions::Musical {
-        prepared = super::level::calibrate(prepared);
-    }
     Ok(prepared)
 }
 
@@ -635,6 +622,16 @@ pub fn peak_frequency(signal: &[f64], sample_rate: f64) -> Option<f64> {
 }
 
 impl Prepared {
+    /// What preparing the model found.
+    pub fn facts(&self) -> &Facts {
+        &self.facts
+    }
+
+    /// The facts while the model is being prepared (the level calibration writes its trims).
+    pub(crate) fn facts_mut(&mut self) -> &mut Facts {
+        Arc::make_mut(&mut self.facts)
+    }
+
     /// Fills the planar input scratch for one chunk of `len` samples from the host channels
     /// (`host_in`, indexed as [`super::host::channel`] numbers them). Each model input takes
     /// the channel its `~route` names, else the next of `order`; a position input receives
@@ -654,17 +651,17 @@ impl Prepared {
         trigger: bool,
     ) -> bool {
         let mut fed = false;
-        for (k, role) in self.roles.iter().enumerate() {
-            let source = self.routing[k].or_else(|| order.get(k).copied());
+        for (k, role) in self.facts.roles.iter().enumerate() {
+            let source = self.facts.routing[k].or_else(|| order.get(k).copied());
             let gain = match role {
                 // In trigger mode the host's signals that push the model become strikes.
                 InputRole::Force | InputRole::Position if trigger => 0.0,
-                InputRole::Force => force * self.force_scale * self.input_trim,
-                InputRole::Position => position * self.input_trim,
+                InputRole::Force => force * self.facts.force_scale * self.facts.input_trim,
+                InputRole::Position => position * self.facts.input_trim,
                 InputRole::AudioParam => 1.0,
                 InputRole::Unused => 0.0,
             };
-            let rest = self.rest[k];
+            let rest = self.facts.rest[k];
             let dst = &mut self.inputs[k * len..(k + 1) * len];
             match source
                 .and_then(super::host::channel)
@@ -689,10 +686,10 @@ impl Prepared {
         self.bank = (voices > 1).then(|| {
             VoiceBank::new(
                 &self.engine,
-                self.roles.len(),
-                self.num_outputs,
+                self.facts.roles.len(),
+                self.facts.num_outputs,
                 voices,
-                self.sample_rate,
+                self.facts.sample_rate,
             )
         });
     }
@@ -701,10 +698,10 @@ impl Prepared {
     /// input's units after the host gains: × Force Gain (and the force rate scale) for a
     /// force input, × Position Gain for a position input.
     pub fn pressure_gain(&self, force: f64, position: f64) -> Option<(usize, f64)> {
-        let k = self.settings.pressure_input? as usize;
-        let scale = self.settings.pressure_scale;
-        let gain = match self.roles.get(k)? {
-            InputRole::Force => scale * force * self.force_scale,
+        let k = self.facts.settings.pressure_input? as usize;
+        let scale = self.facts.settings.pressure_scale;
+        let gain = match self.facts.roles.get(k)? {
+            InputRole::Force => scale * force * self.facts.force_scale,
             InputRole::Position => scale * position,
             InputRole::AudioParam => scale,
             InputRole::Unused => return None,
@@ -720,7 +717,7 @@ impl Prepared {
     /// The force of a note's strike per unit of velocity response: the script's note force ×
     /// the rate scale × `force` (the Force gain).
     pub fn strike_force(&self, force: f64) -> f64 {
-        self.settings.note_force * self.strike_scale * force
+        self.facts.settings.note_force * self.facts.strike_scale * force
     }
 
     /// The key the model plays before any note, and that a strike without a key (the
@@ -728,10 +725,10 @@ impl Prepared {
     /// that it sounds where its level was measured ([`super::level`]); the `~key` at which an
     /// unpitched model (or a legacy project's) sounds as written.
     pub fn home_key(&self) -> f64 {
-        if self.conventions == Conventions::Musical && !self.settings.unpitched {
-            f64::from(super::level::MEASURE_KEY)
+        if self.facts.conventions == Conventions::Musical && !self.facts.settings.unpitched {
+            f64::from(HOME_KEY)
         } else {
-            self.settings.reference_key
+            self.facts.settings.reference_key
         }
     }
 
@@ -739,18 +736,19 @@ impl Prepared {
     /// clamp holds the Stiffness gain a note asks for (the exact law inverted at the
     /// envelope's largest gain). None without a reference pitch or a limit.
     pub fn highest_key(&self) -> Option<f64> {
-        let f = self.settings.reference_pitch_hz?;
-        let g = self.envelope.max_stiffness(1.0);
-        if !(g.is_finite() && f > 0.0 && f < 0.49 * self.sample_rate) {
+        let f = self.facts.settings.reference_pitch_hz?;
+        let g = self.facts.envelope.max_stiffness(1.0);
+        if !(g.is_finite() && f > 0.0 && f < 0.49 * self.facts.sample_rate) {
             return None;
         }
-        let s = g.sqrt() * (std::f64::consts::PI * f / self.sample_rate).sin();
+        let s = g.sqrt() * (std::f64::consts::PI * f / self.facts.sample_rate).sin();
         let top = if s >= 1.0 {
-            0.49 * self.sample_rate
+            0.49 * self.facts.sample_rate
         } else {
-            (self.sample_rate / std::f64::consts::PI * s.asin()).min(0.49 * self.sample_rate)
+            (self.facts.sample_rate / std::f64::consts::PI * s.asin())
+                .min(0.49 * self.facts.sample_rate)
         };
-        Some(self.settings.reference_key + 12.0 * (top / f).log2())
+        Some(self.facts.settings.reference_key + 12.0 * (top / f).log2())
     }
 
     /// Puts the one model's gestures at rest, with no key holding them.
@@ -764,9 +762,9 @@ impl Prepared {
     /// chunk being filled (`len` samples): the script's note force × the rate scale ×
     /// `force` (the Force gain).
     pub fn strike(&mut self, frame: usize, len: usize, velocity: f64, force: f64) {
-        if let Some(k) = self.note_input {
+        if let Some(k) = self.facts.note_input {
             self.inputs[k * len + frame] +=
-                self.settings.note_force * self.strike_scale * velocity * force;
+                self.facts.settings.note_force * self.facts.strike_scale * velocity * force;
         }
     }
 }
