@@ -161,6 +161,9 @@ pub(crate) fn modes(a: &ModesArgs) -> Result<(), Failure> {
         analysis.modes.len()
     );
     print!("{}", format_modes(&analysis, false));
+    if let Some(why) = &analysis.skipped {
+        println!("modal analysis skipped: {why}");
+    }
     let silent = silent_inputs(&analysis, &gain_columns(&analysis));
     if !silent.is_empty() {
         println!("no gain at rest from {silent} (open contacts or parameter inputs)");

@@ -26,6 +26,7 @@
 //! [`crate::instrument`]'s envelope remains.
 
 use super::system::{SymSparse, System};
+use super::ANALYSIS_LIMIT;
 use crate::analysis::network::{Network, Valuation};
 use crate::{Engine, ScaleClass};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -232,8 +233,14 @@ impl Engine {
         let a_z = SymSparse::combine(2.0, &z_side.z, 0.0, &z_side.k, &vec![0.0; z_side.len()]);
         let four_m: Vec<f64> = k_side.mass.iter().map(|m| 4.0 * m).collect();
         let net = Network::walk(self, Valuation::Bound);
-        let finite =
-            four_m.iter().all(|m| m.is_finite() && *m > 0.0) && a_k.is_finite() && a_z.is_finite();
+        // Finite, and within what a factorisation takes once normalised by the masses (as
+        // the modal analysis requires, [`ANALYSIS_LIMIT`]): otherwise the Gershgorin bound.
+        let masses = four_m.iter().all(|m| m.is_finite() && *m > 0.0);
+        let finite = masses && {
+            let inv_sqrt: Vec<f64> = four_m.iter().map(|m| 2.0 / m.sqrt()).collect();
+            a_k.scaled(&inv_sqrt).is_within(ANALYSIS_LIMIT)
+                && a_z.scaled(&inv_sqrt).is_within(ANALYSIS_LIMIT)
+        };
         let nonnegative = net.links.iter().all(|l| l.k >= 0.0 && l.z >= 0.0)
             && net.k_ground.iter().chain(&net.z_ground).all(|v| *v >= 0.0);
         let (pattern, terms) = entry_terms(&a_k, &a_z, &four_m);

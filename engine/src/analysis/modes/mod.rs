@@ -48,6 +48,13 @@ use system::System;
 /// sparse solver.
 pub const DENSE_LIMIT: usize = 1500;
 
+/// The largest magnitude of an entry of the mass-normalised matrices M^−½·K·M^−½ and
+/// M^−½·Z·M^−½ (per step) that the analyses give an eigensolver or a factorisation. A stable
+/// model's entries are below 4 (spec §5.2), so no model worth analysing comes near; beyond it
+/// the products inside the solvers overflow, and a script value of 10³⁰⁸ made a dense solver
+/// assert (faer's real Schur decomposition) or never return.
+pub const ANALYSIS_LIMIT: f64 = 1e50;
+
 /// Up to this many moving points, non-proportional damping is solved exactly with the 2N
 /// companion matrix; above, with the projected damping ψᵀΓψ.
 pub const COMPANION_LIMIT: usize = 400;
@@ -110,6 +117,10 @@ pub struct ModalAnalysis {
     pub proportional: bool,
     /// The number of moving points.
     pub degrees_of_freedom: usize,
+    /// Why no mode was computed, when the analysis could not run on this model: values the
+    /// eigensolvers cannot take, or a solver that failed. The model still plays (the
+    /// instrument then uses the Gershgorin clamp and the impulse pitch estimate).
+    pub skipped: Option<String>,
 }
 
 impl ModalAnalysis {
@@ -219,12 +230,16 @@ impl Engine {
         let rest = self.rest_positions();
         let net = Network::walk(self, Valuation::Rest(&rest));
         let sys = System::assemble(self, &net, true);
-        solve::modes(
-            &sys,
-            self.model.info.num_points,
-            self.sample_rate_hz(),
-            count,
-        )
+        let (num_points, sample_rate) = (self.model.info.num_points, self.sample_rate_hz());
+        // A failure inside a linear-algebra crate ends this analysis, not the host.
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            solve::modes(&sys, num_points, sample_rate, count)
+        }))
+        .unwrap_or_else(|_| {
+            let mut empty = solve::unsolved(&sys, sample_rate);
+            empty.skipped = Some("the eigensolver failed on this model".into());
+            empty
+        })
     }
 
     /// The reference pitch of issue 14: the frequency of the strongest mode (above 20 Hz) that

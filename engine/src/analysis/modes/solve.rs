@@ -4,13 +4,31 @@
 
 use super::sparse::lowest_eigenpairs;
 use super::system::{Port, System};
-use super::{ModalAnalysis, Mode, Solver, COMPANION_LIMIT, DEFAULT_SPARSE_COUNT, DENSE_LIMIT};
+use super::{
+    ModalAnalysis, Mode, Solver, ANALYSIS_LIMIT, COMPANION_LIMIT, DEFAULT_SPARSE_COUNT, DENSE_LIMIT,
+};
 use faer::linalg::solvers::Solve;
 use faer::{c64, Mat, Side};
 
 /// Damping counts as proportional when the off-diagonal part of ψᵀΓψ is below this fraction
 /// of its largest entry.
 const PROPORTIONAL_TOLERANCE: f64 = 1e-9;
+
+/// An analysis of `sys` with no mode yet.
+pub(super) fn unsolved(sys: &System, sample_rate: f64) -> ModalAnalysis {
+    ModalAnalysis {
+        sample_rate_hz: sample_rate,
+        modes: Vec::new(),
+        num_inputs: sys.inputs.len(),
+        num_outputs: sys.outputs.len(),
+        input_linear: sys.inputs.iter().map(|p| p.linear).collect(),
+        output_linear: sys.outputs.iter().map(|p| p.linear).collect(),
+        solver: Solver::Dense,
+        proportional: true,
+        degrees_of_freedom: sys.len(),
+        skipped: None,
+    }
+}
 
 pub(super) fn modes(
     sys: &System,
@@ -22,18 +40,20 @@ pub(super) fn modes(
     let inv_sqrt_m: Vec<f64> = sys.mass.iter().map(|m| 1.0 / m.sqrt()).collect();
     let s = sys.k.scaled(&inv_sqrt_m);
     let gamma = sys.z.scaled(&inv_sqrt_m);
-    let mut analysis = ModalAnalysis {
-        sample_rate_hz: sample_rate,
-        modes: Vec::new(),
-        num_inputs: sys.inputs.len(),
-        num_outputs: sys.outputs.len(),
-        input_linear: sys.inputs.iter().map(|p| p.linear).collect(),
-        output_linear: sys.outputs.iter().map(|p| p.linear).collect(),
-        solver: Solver::Dense,
-        proportional: true,
-        degrees_of_freedom: n,
-    };
-    if n == 0 || !s.is_finite() || !gamma.is_finite() || sys.mass.iter().any(|m| !(*m > 0.0)) {
+    let mut analysis = unsolved(sys, sample_rate);
+    if n == 0 {
+        return analysis;
+    }
+    if let Some(bad) = sys.mass.iter().find(|m| !(m.is_finite() && **m > 0.0)) {
+        analysis.skipped = Some(format!(
+            "a moving mass of {bad:e}: masses must be finite and positive"
+        ));
+        return analysis;
+    }
+    if !(s.is_within(ANALYSIS_LIMIT) && gamma.is_within(ANALYSIS_LIMIT)) {
+        analysis.skipped = Some(format!(
+            "stiffness or damping over mass beyond {ANALYSIS_LIMIT:e} per step (or not finite)"
+        ));
         return analysis;
     }
     let (lambdas, psi) = if n <= DENSE_LIMIT {

@@ -91,9 +91,9 @@ impl SymSparse {
         faer::sparse::SparseColMat::try_new_from_triplets(self.n, self.n, &triplets).ok()
     }
 
-    /// True when every value is finite.
-    pub fn is_finite(&self) -> bool {
-        self.entries.iter().all(|e| e.2.is_finite())
+    /// True when every value is finite and at most `limit` in magnitude.
+    pub fn is_within(&self, limit: f64) -> bool {
+        self.entries.iter().all(|e| e.2.abs() <= limit)
     }
 }
 
