@@ -147,9 +147,13 @@ impl Ressort {
             if let Some(slot) = self.held.iter_mut().find(|s| s.is_none()) {
                 *slot = Some(back);
             } else {
-                // Every holding slot is taken and the return channel is full: keep the
-                // model alive rather than free it here.
-                std::mem::forget(back);
+                // `receive_models` takes a new model only with two slots free, and the
+                // instrument gives back at most two models per model it takes (the one it
+                // fades out, then the one it retires), so a slot is always free here. Were
+                // one not, freeing here is a deallocation on the audio thread, which
+                // `assert_process_allocs` builds report, never a leak.
+                debug_assert!(false, "no holding slot for a returned model");
+                drop(back);
             }
         }
     }
@@ -162,6 +166,12 @@ impl Ressort {
                     self.held[i] = Some(back);
                 }
             }
+        }
+        // A new model stays in the store while fewer than two holding slots are free: it
+        // may give two models back (see `recycle`), and the main thread has not yet taken
+        // the ones returned before.
+        if self.held.iter().filter(|s| s.is_none()).count() < 2 {
+            return;
         }
         let Some(new) = self.store.receive() else {
             return;
