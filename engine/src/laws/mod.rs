@@ -17,6 +17,7 @@ mod arith;
 mod classes;
 mod cubic;
 pub(crate) mod linear;
+pub(crate) mod nodes;
 pub(crate) use classes::{ArgClass, NUM_ARG_CLASSES};
 mod table;
 

@@ -4,6 +4,8 @@
 use super::proxies::Proxies;
 use super::Points;
 use crate::laws;
+use crate::laws::nodes::{node_step, stiffness_spring};
+use crate::laws::Scalar;
 use crate::sim::kernels::mesh::{mesh_step_passes, mesh_step_rows, ROW_SWEEP_NODES};
 
 /// The argument slots of one macro in `Engine::args`: M, K, K2 (stiff strings), Z, Zo.
@@ -76,13 +78,9 @@ impl MeshMacro {
     }
 }
 
-/// The per-step coefficients of the ground-friction node law of spec §2.7:
-/// X[n+1] = (2 − Zo/M)·X + (Zo/M − 1)·X̃ + F/M.
-#[inline(always)]
-pub(crate) fn node_law(m: f64, zo: f64) -> (f64, f64, f64) {
-    let zm = zo / m;
-    (2.0 - zm, zm - 1.0, 1.0 / m)
-}
+/// The per-step coefficients of the ground-friction node law of spec §2.7
+/// ([`crate::laws::nodes`]).
+pub(crate) use crate::laws::nodes::node_coefficients as node_law;
 
 /// Stage 2 b: all macro structures. Each updates its nodes, then adds its internal forces.
 #[derive(Clone, Debug, Default)]
@@ -195,7 +193,7 @@ fn update_line_nodes(mac: &LineMacro, x: &mut [f64], xp: &mut [f64], f: &mut [f6
         (0, n)
     };
     for i in lo..hi {
-        let next = a * x[i] + b * xp[i] + f[i] * inv_m;
+        let next = node_step(&Scalar, (a, b, inv_m), x[i], xp[i], f[i]);
         xp[i] = x[i];
         x[i] = next;
     }
@@ -236,7 +234,7 @@ fn stiffness_links(x: &[f64], f: &mut [f64], k2: f64) {
     for i in -1..n {
         let a = i.clamp(0, n - 1) as usize;
         let b = (i + 2).clamp(0, n - 1) as usize;
-        let t = k2 * (x[a] - x[b]);
+        let t = stiffness_spring(&Scalar, k2, x[a], x[b]);
         f[a] -= t;
         f[b] += t;
     }

@@ -10,6 +10,8 @@
 
 use super::macros::{node_law, MeshMacro};
 use crate::laws;
+use crate::laws::nodes::node_step;
+use crate::laws::Scalar;
 
 /// Meshes with at least this many nodes run row by row ([`mesh_step_rows`]): from there the
 /// six passes stream more than the caches hold. Smaller ones keep the script's summation
@@ -39,7 +41,7 @@ pub(crate) fn mesh_step_passes(
     let n = len * w;
     let x_edge = x[0];
     for i in 0..n {
-        let next = a * x[i] + b * xp[i] + f[i] * inv_m;
+        let next = node_step(&Scalar, (a, b, inv_m), x[i], xp[i], f[i]);
         xp[i] = x[i];
         x[i] = next;
     }

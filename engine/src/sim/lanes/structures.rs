@@ -4,8 +4,10 @@
 //! schedule, `kernels::proxies`) in their order, so each lane equals a plain engine bit for bit
 //! (engine test `lanes`).
 
+use super::arith::Native;
 use super::vector::{self, Ops};
 use super::{Lanes, LANES};
+use crate::laws::nodes::{node_step, stiffness_spring};
 use crate::sim::engine::{node_law, LineMacro, MeshMacro, Proxies};
 
 /// Per-lane node law coefficients (a, b, 1/M) of a macro from its M and Zo slots.
@@ -21,8 +23,8 @@ fn lane_node_law(args: &[Lanes], m: usize, zo: usize) -> (Lanes, Lanes, Lanes) {
     out
 }
 
-/// Node law of a macro's moving nodes `nodes` (`kernels::macros::node_law`): X[n+1] =
-/// a·X + b·X̃ + F·(1/M), per lane.
+/// Node law of a macro's moving nodes `nodes` ([`node_step`]): X[n+1] = a·X + b·X̃ + F·(1/M),
+/// per lane, native vector by native vector.
 #[inline(always)]
 fn update_nodes<S: pulp::Simd>(
     o: Ops<S>,
@@ -32,12 +34,25 @@ fn update_nodes<S: pulp::Simd>(
     f: &[Lanes],
     nodes: std::ops::Range<usize>,
 ) {
+    let ar = Native(o.0);
+    let (a, b, inv_m) = (vectors::<S>(&a), vectors::<S>(&b), vectors::<S>(&inv_m));
     let (x, xp, f) = (&mut x[nodes.clone()], &mut xp[nodes.clone()], &f[nodes]);
     for ((x, xp), f) in x.iter_mut().zip(xp.iter_mut()).zip(f) {
-        let next = o.add(o.add(o.mul(a, *x), o.mul(b, *xp)), o.mul(*f, inv_m));
+        let mut next = Lanes::ZERO;
+        let (xv, xpv, fv) = (vectors::<S>(x), vectors::<S>(xp), vectors::<S>(f));
+        let (out, _) = S::as_mut_simd_f64s(&mut next.0);
+        for v in 0..out.len() {
+            out[v] = node_step(&ar, (a[v], b[v], inv_m[v]), xv[v], xpv[v], fv[v]);
+        }
         *xp = *x;
         *x = next;
     }
+}
+
+/// The native vectors of a [`Lanes`] (every lane: [`LANES`] is a whole number of vectors).
+#[inline(always)]
+fn vectors<S: pulp::Simd>(v: &Lanes) -> &[S::f64s] {
+    S::as_simd_f64s(&v.0).0
 }
 
 /// A string, chain or stiff string (`kernels::macros`: `update_line_nodes`, `chain_links`,
@@ -87,7 +102,12 @@ pub(super) fn line_step<S: pulp::Simd>(
         for i in -1..n {
             let p = i.clamp(0, n - 1) as usize;
             let q = (i + 2).clamp(0, n - 1) as usize;
-            let t = o.mul(k2, o.sub(x[p], x[q]));
+            let mut t = Lanes::ZERO;
+            let (k2v, xa, xb) = (vectors::<S>(&k2), vectors::<S>(&x[p]), vectors::<S>(&x[q]));
+            let (out, _) = S::as_mut_simd_f64s(&mut t.0);
+            for v in 0..out.len() {
+                out[v] = stiffness_spring(&Native(o.0), k2v[v], xa[v], xb[v]);
+            }
             f[p] = o.sub(f[p], t);
             f[q] = o.add(f[q], t);
         }
