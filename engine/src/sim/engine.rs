@@ -49,7 +49,7 @@ pub(crate) struct BlockIo<'a> {
 }
 
 pub(crate) use crate::sim::kernels::links::{Group, Interactions};
-pub(crate) use crate::sim::kernels::macros::{node_law, LineMacro, MacroSlots, Macros, MeshMacro};
+pub(crate) use crate::sim::kernels::macros::{LineMacro, MacroSlots, Macros, MeshMacro};
 pub(crate) use crate::sim::kernels::proxies::Proxies;
 
 /// The default runaway limit on positions and outputs, in model units. Reference models move
@@ -67,7 +67,7 @@ pub const DEFAULT_POSITION_LIMIT: f64 = 1.0e4;
 /// chain of the law groups.
 #[derive(Clone, Debug)]
 pub struct Engine {
-    /// Structure, routes, expressions, labels and native code: never written after
+    /// Labels and metadata, expressions, routes and initial-state runs: never written after
     /// compilation.
     pub(crate) model: Arc<Compiled>,
 

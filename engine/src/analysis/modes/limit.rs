@@ -238,8 +238,8 @@ impl Engine {
         let masses = four_m.iter().all(|m| m.is_finite() && *m > 0.0);
         let finite = masses && {
             let inv_sqrt: Vec<f64> = four_m.iter().map(|m| 2.0 / m.sqrt()).collect();
-            a_k.scaled(&inv_sqrt).is_within(ANALYSIS_LIMIT)
-                && a_z.scaled(&inv_sqrt).is_within(ANALYSIS_LIMIT)
+            a_k.scaled_is_within(&inv_sqrt, ANALYSIS_LIMIT)
+                && a_z.scaled_is_within(&inv_sqrt, ANALYSIS_LIMIT)
         };
         let nonnegative = net.links.iter().all(|l| l.k >= 0.0 && l.z >= 0.0)
             && net.k_ground.iter().chain(&net.z_ground).all(|v| *v >= 0.0);

@@ -95,6 +95,13 @@ impl SymSparse {
     pub fn is_within(&self, limit: f64) -> bool {
         self.entries.iter().all(|e| e.2.abs() <= limit)
     }
+
+    /// [`SymSparse::is_within`] for D·A·D, without forming it.
+    pub fn scaled_is_within(&self, d: &[f64], limit: f64) -> bool {
+        self.entries
+            .iter()
+            .all(|&(i, j, v)| (v * d[i as usize] * d[j as usize]).abs() <= limit)
+    }
 }
 
 /// A signal vector over the moving points whose value at a mode with eigenvalue r is

@@ -4,7 +4,7 @@
 use super::proxies::Proxies;
 use super::Points;
 use crate::laws;
-use crate::laws::nodes::{node_step, stiffness_spring};
+use crate::laws::nodes::{node_coefficients, node_step, stiffness_spring};
 use crate::laws::Scalar;
 use crate::sim::kernels::mesh::{mesh_step_passes, mesh_step_rows, ROW_SWEEP_NODES};
 
@@ -77,10 +77,6 @@ impl MeshMacro {
         }
     }
 }
-
-/// The per-step coefficients of the ground-friction node law of spec §2.7
-/// ([`crate::laws::nodes`]).
-pub(crate) use crate::laws::nodes::node_coefficients as node_law;
 
 /// Stage 2 b: all macro structures. Each updates its nodes, then adds its internal forces.
 #[derive(Clone, Debug, Default)]
@@ -185,7 +181,7 @@ fn take_spread_forces<'a>(
 /// has them reset here).
 #[inline(always)]
 fn update_line_nodes(mac: &LineMacro, x: &mut [f64], xp: &mut [f64], f: &mut [f64], args: &[f64]) {
-    let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
+    let (a, b, inv_m) = node_coefficients(args[mac.slots.m], args[mac.slots.zo]);
     let n = x.len();
     let (lo, hi) = if mac.fixed_ends {
         (1, n.saturating_sub(1))

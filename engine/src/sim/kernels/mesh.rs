@@ -8,9 +8,9 @@
 //! [`Macros::step`](super::macros::Macros::step) picks by size; a test runs both from the
 //! same state and compares the positions within rounding.
 
-use super::macros::{node_law, MeshMacro};
+use super::macros::MeshMacro;
 use crate::laws;
-use crate::laws::nodes::node_step;
+use crate::laws::nodes::{node_coefficients, node_step};
 use crate::laws::Scalar;
 
 /// Meshes with at least this many nodes run row by row ([`mesh_step_rows`]): from there the
@@ -35,7 +35,7 @@ pub(crate) fn mesh_step_passes(
     s: &mut [f64],
     args: &[f64],
 ) {
-    let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
+    let (a, b, inv_m) = node_coefficients(args[mac.slots.m], args[mac.slots.zo]);
     let (k, z) = (args[mac.slots.k], args[mac.slots.z]);
     let (len, w) = (mac.length, mac.width);
     let n = len * w;
@@ -123,7 +123,7 @@ pub(crate) fn mesh_step_rows(
     args: &[f64],
     avx2: bool,
 ) {
-    let (a, b, inv_m) = node_law(args[mac.slots.m], args[mac.slots.zo]);
+    let (a, b, inv_m) = node_coefficients(args[mac.slots.m], args[mac.slots.zo]);
     let (k, z) = mac.last_kz;
     mac.last_kz = (args[mac.slots.k], args[mac.slots.z]);
     let law = Stencil {

@@ -7,15 +7,16 @@
 use super::arith::Native;
 use super::vector::{self, Ops};
 use super::{Lanes, LANES};
+use crate::laws::nodes::node_coefficients;
 use crate::laws::nodes::{node_step, stiffness_spring};
-use crate::sim::engine::{node_law, LineMacro, MeshMacro, Proxies};
+use crate::sim::engine::{LineMacro, MeshMacro, Proxies};
 
 /// Per-lane node law coefficients (a, b, 1/M) of a macro from its M and Zo slots.
 #[inline(always)]
 fn lane_node_law(args: &[Lanes], m: usize, zo: usize) -> (Lanes, Lanes, Lanes) {
     let mut out = (Lanes::ZERO, Lanes::ZERO, Lanes::ZERO);
     for l in 0..LANES {
-        let (a, b, inv_m) = node_law(args[m][l], args[zo][l]);
+        let (a, b, inv_m) = node_coefficients(args[m][l], args[zo][l]);
         out.0[l] = a;
         out.1[l] = b;
         out.2[l] = inv_m;
