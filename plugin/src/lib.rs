@@ -506,6 +506,15 @@ impl Plugin for Ressort {
         self.instrument.set_watching(self.editor_state.is_open());
         let frames = buffer.samples();
         let controls = self.controls();
+        // The control grid follows the song while the transport plays, so that a bounce
+        // does not depend on when the host activated the plugin.
+        let transport = context.transport();
+        let song = if transport.playing {
+            transport.pos_samples()
+        } else {
+            None
+        };
+        self.instrument.set_song_position(song);
 
         // Host inputs: the sidechain's channels; the main bus is read in place.
         let mut host_in: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];

@@ -46,11 +46,12 @@ use clack_extensions::state::{HostState, HostStateImpl, PluginState, StateError}
 use clack_extensions::thread_check::{HostThreadCheck, HostThreadCheckImpl};
 use clack_host::events::event_types::{
     MidiEvent, NoteEndEvent, NoteExpressionEvent, NoteOffEvent, NoteOnEvent, ParamModEvent,
-    ParamValueEvent,
+    ParamValueEvent, TransportEvent, TransportFlags,
 };
-use clack_host::events::Match;
+use clack_host::events::{EventFlags, Match};
 use clack_host::host::HostError;
 use clack_host::prelude::*;
+use clack_host::utils::{BeatTime, SecondsTime};
 use std::cell::Cell;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -591,6 +592,9 @@ pub struct Block<'a> {
     pub main_input: Option<[&'a [f32]; 2]>,
     /// Events, with times relative to the block's start (sorted by the host before sending).
     pub events: &'a [HostEvent],
+    /// The song position of the block's first sample while the transport plays (sent in
+    /// seconds and in beats at 120 BPM, as a DAW does); `None`: a free-running host.
+    pub song_position: Option<u64>,
 }
 
 impl Block<'_> {
@@ -1365,6 +1369,9 @@ impl TestPlugin {
         let in_events = InputEvents::from_buffer(&io.events);
         let mut out_events = OutputEvents::from_buffer(&mut io.out_events);
         let steady = io.steady_time;
+        let transport = block
+            .song_position
+            .map(|p| playing_transport(p, io.config.sample_rate));
         let result = as_audio_thread(|| {
             processor.process(
                 &inputs,
@@ -1372,7 +1379,7 @@ impl TestPlugin {
                 &in_events,
                 &mut out_events,
                 Some(steady),
-                None,
+                transport.as_ref(),
             )
         });
         io.steady_time += n as u64;
@@ -1397,7 +1404,21 @@ impl TestPlugin {
 
     /// [`TestPlugin::render`] by frame count.
     pub fn render_frames(&mut self, frames: usize, block_size: usize, score: &Score) -> Rendered {
-        assert!(block_size >= 1);
+        self.render_song(frames, &[block_size], None, score)
+    }
+
+    /// Renders `frames` samples in blocks whose sizes cycle through `block_sizes`, feeding the
+    /// score (event times from the render's start). With `song_start`, the transport plays
+    /// and each block carries its song position, `song_start` at the render's first sample.
+    pub fn render_song(
+        &mut self,
+        frames: usize,
+        block_sizes: &[usize],
+        song_start: Option<u64>,
+        score: &Score,
+    ) -> Rendered {
+        assert!(!block_sizes.is_empty() && block_sizes.iter().all(|&b| b >= 1));
+        let block_size = block_sizes[0];
         let mut sidechain = score.sidechain.clone();
         sidechain.pad_to(frames);
         let mut main = score.main_input.clone();
@@ -1415,8 +1436,9 @@ impl TestPlugin {
         };
         let mut next_event = 0;
         let mut start = 0;
+        let mut sizes = block_sizes.iter().copied().cycle();
         while start < frames {
-            let n = block_size.min(frames - start);
+            let n = sizes.next().unwrap_or(block_size).min(frames - start);
             let end = start + n;
             let first = next_event;
             while next_event < events.len() && (events[next_event].time() as usize) < end {
@@ -1434,6 +1456,7 @@ impl TestPlugin {
                     .as_ref()
                     .map(|m| [&m.left[start..end], &m.right[start..end]]),
                 events: &block_events,
+                song_position: song_start.map(|s| s + start as u64),
             };
             let processed = self.process(&block);
             out.audio.left.extend_from_slice(processed.left);
@@ -1918,4 +1941,30 @@ fn plugin_with(
         state::model(&compiled).map(|m| m.0)
     );
     plugin
+}
+
+/// A playing transport at `position` samples: seconds, and beats at 120 BPM in 4/4.
+fn playing_transport(position: u64, sample_rate: f64) -> TransportEvent {
+    let seconds = position as f64 / sample_rate;
+    let beats = seconds * 2.0;
+    TransportEvent {
+        header: EventHeader::new_core(0, EventFlags::empty()),
+        flags: TransportFlags::IS_PLAYING
+            | TransportFlags::HAS_SECONDS_TIMELINE
+            | TransportFlags::HAS_BEATS_TIMELINE
+            | TransportFlags::HAS_TEMPO
+            | TransportFlags::HAS_TIME_SIGNATURE,
+        song_pos_beats: BeatTime::from_float(beats),
+        song_pos_seconds: SecondsTime::from_float(seconds),
+        tempo: 120.0,
+        tempo_inc: 0.0,
+        loop_start_beats: BeatTime::from_int(0),
+        loop_end_beats: BeatTime::from_int(0),
+        loop_start_seconds: SecondsTime::from_int(0),
+        loop_end_seconds: SecondsTime::from_int(0),
+        bar_start: BeatTime::from_float((beats / 4.0).floor() * 4.0),
+        bar_number: (beats / 4.0).floor() as i32,
+        time_signature_numerator: 4,
+        time_signature_denominator: 4,
+    }
 }

@@ -166,12 +166,16 @@ pub struct Instrument {
     /// Output gain where the current chunk's per-sample ramp starts.
     last_output_gain: f64,
     /// Length of the current chunk and the samples of it already rendered. A chunk runs to
-    /// the next multiple of CHUNK (counted from the start), so the sound does not depend on
-    /// the host's block size; automation and notes start a new chunk at their own sample.
+    /// the next multiple of CHUNK (counted from the start, or from the host's song position;
+    /// see [`Instrument::set_song_position`]), so the sound does not depend on the host's
+    /// block size; automation and notes start a new chunk at their own sample.
     chunk_len: usize,
     chunk_done: usize,
-    /// Samples since the start: chunk boundaries are multiples of CHUNK.
+    /// Samples since the start, or the song position: chunk boundaries are multiples of
+    /// CHUNK.
     counter: u64,
+    /// The song position at the next call's first sample, while the host's transport plays.
+    song_position: Option<i64>,
     output: OutputStage,
     /// The key of the last note the one model played (its home key until then), and the
     /// pitch bend.
@@ -222,6 +226,7 @@ impl Instrument {
             chunk_len: 0,
             chunk_done: 0,
             counter: 0,
+            song_position: None,
             output: OutputStage::new(sample_rate),
             note_key: None,
             bend_st: 0.0,
@@ -252,6 +257,18 @@ impl Instrument {
     /// Whether someone watches the model's motion (the editor is open).
     pub fn set_watching(&mut self, watching: bool) {
         self.watching = watching;
+    }
+
+    /// The host's song position (in samples) at the first sample of the next
+    /// [`Instrument::process`] call, while its transport plays; `None` when it is stopped or
+    /// gives none. The control grid (chunks of [`CHUNK`] samples at which the smoothed
+    /// controls step) is then anchored to the song: a grid point falls on every multiple of
+    /// CHUNK of the song position. A bounce of the same project thus renders the same samples
+    /// whenever the host activated the plugin and whatever its block sizes; without a song
+    /// position the grid counts from activation. When the position jumps (a loop, a locate)
+    /// off the grid, a chunk starts there, as at an automation point. Realtime-safe.
+    pub fn set_song_position(&mut self, position: Option<i64>) {
+        self.song_position = position;
     }
 
     /// Maps MIDI controllers to macro slots: a [`Event::Controller`] of a mapped number moves
@@ -470,6 +487,14 @@ impl Instrument {
         }
         let mut automated = controls != self.controls;
         self.controls = controls;
+        // Off the song's grid: a new chunk starts here, on it.
+        if let Some(p) = self.song_position.take().filter(|_| frames > 0) {
+            let phase = p.rem_euclid(CHUNK as i64) as u64;
+            if self.counter % CHUNK as u64 != phase {
+                self.counter = phase;
+                automated = true;
+            }
+        }
         let mut report = BlockReport::default();
         // The host channels that push the model: the input meter's, and with the sidechain's
         // pair, the trigger's.

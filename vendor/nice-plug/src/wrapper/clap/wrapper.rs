@@ -2171,11 +2171,8 @@ impl<P: ClapPlugin> Wrapper<P> {
                     if context.flags & CLAP_TRANSPORT_HAS_SECONDS_TIMELINE != 0 {
                         let seconds = context.song_pos_seconds as f64 / CLAP_SECTIME_FACTOR as f64;
 
-                        // Same here
-                        if P::SAMPLE_ACCURATE_AUTOMATION
-                            && block_start > 0
-                            && (context.flags & CLAP_TRANSPORT_HAS_TEMPO != 0)
-                        {
+                        // Same here; seconds advance with the samples, whatever the tempo.
+                        if P::SAMPLE_ACCURATE_AUTOMATION && block_start > 0 {
                             transport.pos_seconds =
                                 Some(seconds + (block_start as f64 / sample_rate as f64));
                         } else {
