@@ -52,6 +52,8 @@ struct Player {
 struct Take {
     channels: Vec<Vec<f32>>,
     triggered: u32,
+    /// Guard trips: the model exploded and was reset.
+    trips: u32,
     /// The Stiffness and Damping gains the instrument played the last note with.
     gains: Gains,
 }
@@ -134,6 +136,7 @@ impl Player {
         let block = 480;
         let mut done = 0;
         let mut triggered = 0;
+        let mut trips = 0;
         while done < frames {
             let len = block.min(frames - done);
             let mut evs = events
@@ -149,6 +152,7 @@ impl Player {
                 out.iter_mut().map(|c| &mut c[done..done + len]).collect();
             let report = inst.process(len, &host, false, &mut evs, &controls, &mut slices);
             triggered += report.triggered;
+            trips += report.trips;
             done += len;
         }
         let gains = inst.gains();
@@ -157,6 +161,7 @@ impl Player {
         Take {
             channels: out,
             triggered,
+            trips,
             gains,
         }
     }
@@ -211,6 +216,50 @@ fn every_preset_lands_in_the_level_band_and_velocity_is_loudness() {
     if highest - lowest > SPREAD_DB {
         wrong.push(format!("the levels spread over {:.1} dB", highest - lowest));
     }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// The corners of the macro slots a test plays at: every slot at its bottom, every slot at
+/// its top, and the two alternations (a lighter mass with a stiffer spring, and so on).
+fn macro_corners() -> [(&'static str, [f64; instrument::NUM_MACROS]); 4] {
+    let alternate =
+        |first: f64| std::array::from_fn(|i| if i % 2 == 0 { first } else { 1.0 - first });
+    [
+        ("all at 0", [0.0; instrument::NUM_MACROS]),
+        ("all at 1", [1.0; instrument::NUM_MACROS]),
+        ("0, 1, 0, …", alternate(0.0)),
+        ("1, 0, 1, …", alternate(1.0)),
+    ]
+}
+
+#[test]
+fn every_preset_stays_stable_with_its_macros_at_the_corners() {
+    const SR: f64 = 48_000.0;
+    let mut wrong = Vec::new();
+    let mut played = 0;
+    for (name, script) in presets() {
+        let mut p = Player::new(&script, SR);
+        for (corner, macros) in macro_corners() {
+            let controls = Controls {
+                macros,
+                ..Controls::DEFAULT
+            };
+            let take = p.play(controls, &[(0, Event::note_on(60, 1.0))], None, 1.0);
+            played += 1;
+            let finite = take.channels.iter().flatten().all(|v| v.is_finite());
+            if take.trips > 0 || !finite || take.peak() > 1.0 {
+                wrong.push(format!(
+                    "{name}, macros {corner}: {} guard trip(s), finite {finite}, peak {:.3}",
+                    take.trips,
+                    take.peak()
+                ));
+            }
+        }
+    }
+    println!(
+        "{played} performances at the macro corners, {} wrong",
+        wrong.len()
+    );
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }
 

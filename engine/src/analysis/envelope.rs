@@ -55,7 +55,7 @@ impl StabilityEnvelope {
     /// model's own stiffness away), then Stiffness takes what remains. Returns the gains and
     /// whether anything was clamped.
     pub fn clamp(&self, gk: f64, gz: f64, k_floor: f64) -> (f64, f64, bool) {
-        self.clamp_moved(gk, gz, k_floor, &[])
+        self.clamp_moved(gk, gz, k_floor, self, &[])
     }
 
     pub(crate) fn from_loads(mut loads: Vec<LoadLine>) -> StabilityEnvelope {
@@ -87,14 +87,21 @@ impl StabilityEnvelope {
 
     /// Clamps like [`StabilityEnvelope::clamp`] while macro slots move parameters: `moved`
     /// holds, per moved slot, the envelope at the end of its range it moved towards and how
-    /// far (0 … 1, linear in the parameter value). Each limit is interpolated harmonically
-    /// between this envelope's and the moved one's, which bounds the true limit from below
-    /// when loads depend linearly on the parameter; the tightest slot wins.
+    /// far (0 … 1, linear in the parameter value); `reference` is the envelope of the same
+    /// kind (Gershgorin, scaled alike) at the declared values, which this one may be an
+    /// exact refinement of. Each slot's limit is interpolated harmonically between this
+    /// envelope's and the moved one's, which bounds the true limit from below when loads
+    /// depend linearly on the parameter; the tightest slot sets the limit. The other slots
+    /// that tighten compound on it, each by its own ratio to `reference` (loads go as K/M, so
+    /// a slot lowering a mass and one raising a stiffness on it multiply). A slot that
+    /// loosens changes nothing, as it may act on other masses than a tightening one loads.
+    /// With one slot moved this is that slot's limit.
     pub fn clamp_moved(
         &self,
         gk: f64,
         gz: f64,
         k_floor: f64,
+        reference: &StabilityEnvelope,
         moved: &[(&StabilityEnvelope, f64)],
     ) -> (f64, f64, bool) {
         const TOLERANCE: f64 = 1.0 + 1e-9;
@@ -105,19 +112,31 @@ impl StabilityEnvelope {
             let inv = (1.0 - f) / a.max(1e-300) + f / b.max(1e-300);
             1.0 / inv
         };
-        let z_limit = moved
-            .iter()
-            .fold(self.max_damping(gk.min(k_floor)), |acc, (e, f)| {
-                acc.min(blend(
-                    self.max_damping(gk.min(k_floor)),
-                    e.max_damping(gk.min(k_floor)),
-                    *f,
-                ))
-            });
+        let limit = |of: &dyn Fn(&StabilityEnvelope) -> f64| -> f64 {
+            let base = of(self);
+            let mut tightest = (base, None);
+            for (i, (e, f)) in moved.iter().enumerate() {
+                let l = blend(base, of(e), *f);
+                if l < tightest.0 {
+                    tightest = (l, Some(i));
+                }
+            }
+            let reference = of(reference);
+            let mut acc = tightest.0;
+            if reference.is_finite() && reference > 0.0 {
+                for (i, (e, f)) in moved.iter().enumerate() {
+                    let ratio = blend(reference, of(e), *f) / reference;
+                    if Some(i) != tightest.1 && ratio < 1.0 {
+                        acc *= ratio;
+                    }
+                }
+            }
+            acc
+        };
+        let k_at = gk.min(k_floor);
+        let z_limit = limit(&|e| e.max_damping(k_at));
         let z = gz.min(z_limit * TOLERANCE);
-        let k_limit = moved.iter().fold(self.max_stiffness(z), |acc, (e, f)| {
-            acc.min(blend(self.max_stiffness(z), e.max_stiffness(z), *f))
-        });
+        let k_limit = limit(&|e| e.max_stiffness(z));
         let k = gk.min(k_limit * TOLERANCE);
         (k, z, k < gk || z < gz)
     }

@@ -22,6 +22,7 @@ pub struct ModalModel {
     envelope: StabilityEnvelope,
     macros: Vec<Option<MacroBinding>>,
     macro_envelopes: Vec<Option<(StabilityEnvelope, StabilityEnvelope)>>,
+    macro_reference: StabilityEnvelope,
     /// The model input a note strikes, 1-based as `@in1`.
     pub note_input: Option<usize>,
     /// How many inputs and outputs the model has.
@@ -48,6 +49,7 @@ impl ModalModel {
             envelope: prepared.facts.envelope.clone(),
             macros: prepared.facts.macros.clone(),
             macro_envelopes: prepared.facts.macro_envelopes.clone(),
+            macro_reference: prepared.facts.macro_reference.clone(),
             note_input: prepared.facts.note_input.map(|i| i + 1),
             num_inputs: info.inputs.len(),
             num_outputs: info.outputs.len(),
@@ -68,6 +70,7 @@ impl ModalModel {
             envelope: &self.envelope,
             macros: &self.macros,
             macro_envelopes: &self.macro_envelopes,
+            macro_reference: &self.macro_reference,
         };
         Smoothed::snapped(controls, self.sample_rate).gains(&view, 0.0, 1.0)
     }

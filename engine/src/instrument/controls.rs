@@ -291,6 +291,7 @@ impl Smoothed {
             requested_k,
             requested_z,
             KEPT_STIFFNESS_GAIN,
+            view.macro_reference,
             &moved[..n_moved],
         );
         Gains {
@@ -343,6 +344,9 @@ pub struct ClampView<'a> {
     pub envelope: &'a StabilityEnvelope,
     pub macros: &'a [Option<MacroBinding>],
     pub macro_envelopes: &'a [Option<(StabilityEnvelope, StabilityEnvelope)>],
+    /// The envelope the macro envelopes compare with: the Gershgorin one at the declared
+    /// values ([`Facts::macro_reference`](super::Facts)).
+    pub macro_reference: &'a StabilityEnvelope,
 }
 
 impl<'a> ClampView<'a> {
@@ -353,6 +357,7 @@ impl<'a> ClampView<'a> {
             envelope: &m.facts.envelope,
             macros: &m.facts.macros,
             macro_envelopes: &m.facts.macro_envelopes,
+            macro_reference: &m.facts.macro_reference,
         }
     }
 }

@@ -79,6 +79,7 @@ macro_rules! clamp_view {
             envelope: &$m.facts.envelope,
             macros: &$m.facts.macros,
             macro_envelopes: &$m.facts.macro_envelopes,
+            macro_reference: &$m.facts.macro_reference,
         }
     };
 }

@@ -64,6 +64,9 @@ pub struct Facts {
     /// Per macro slot: the envelopes with its param at the range's minimum and maximum (the
     /// others at their declared values).
     pub macro_envelopes: Vec<Option<(StabilityEnvelope, StabilityEnvelope)>>,
+    /// The Gershgorin envelope at the declared values, of the same kind as the macro
+    /// envelopes: `envelope` may be the exact one, which they are not compared with.
+    pub macro_reference: StabilityEnvelope,
     /// Loads at unit gains: (worst load, label of the worst mass or structure).
     pub worst_load: (f64, String),
     /// The exciters a key plays besides its strike (`~exciter`, [`super::exciters`]).
@@ -270,6 +273,7 @@ pub(crate) fn prepare_uncalibrated(
         macro_units,
         envelope,
         macro_envelopes,
+        macro_reference: gershgorin,
         worst_load,
         settings,
         sample_rate,
