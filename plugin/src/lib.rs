@@ -32,6 +32,7 @@ pub mod plot;
 pub mod presets;
 pub mod report;
 pub mod runtime;
+pub mod state;
 pub mod voices_watch;
 
 pub use ressort_engine::analysis::envelope;
@@ -431,6 +432,11 @@ impl Plugin for Ressort {
     type SysExMessage = ();
     type BackgroundTask = MainThreadTask;
     type Editor = nice_plug_egui::EguiEditor<editor::EditorApp>;
+
+    /// Older states load as they were saved; a newer format is refused (see `state`).
+    fn filter_state(state: &mut PluginState) {
+        state::filter(state);
+    }
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()

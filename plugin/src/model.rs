@@ -228,8 +228,9 @@ pub fn summary(prepared: &mut Prepared) -> ModelSummary {
 }
 
 /// A/B compare: two scripts, one of them running. A model change goes into the running slot;
-/// switching runs the other one (a copy of the first until it is edited).
-#[derive(Clone, Debug, Default, PartialEq)]
+/// switching runs the other one (a copy of the first until it is edited). Saved with the
+/// project (`state::CompareField`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Compare {
     pub slots: [Option<ModelState>; 2],
     /// 0 for A, 1 for B.
@@ -581,6 +582,24 @@ impl ModelStore {
             lock(&self.compare).active = from;
         }
         result
+    }
+
+    /// The A/B slots of a loaded project. The running slot follows the project's model (the
+    /// `model` field, loaded after this one), so only the other slot's script is kept from
+    /// here; a slot number other than 0 or 1 reads as A.
+    pub fn restore_compare(&self, saved: Compare) {
+        let active = if saved.active == 1 { 1 } else { 0 };
+        let mut slots = saved.slots;
+        slots[active] = None;
+        *lock(&self.compare) = Compare { slots, active };
+    }
+
+    /// A state the plugin cannot read was refused: nothing changed but the diagnostics,
+    /// which say why.
+    pub fn refuse_state(&self, why: String) {
+        let mut status = lock(&self.status);
+        status.diagnostics = vec![why];
+        status.rejected = None;
     }
 
     /// Copies the running script into the other A/B slot.

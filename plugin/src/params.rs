@@ -6,6 +6,7 @@ use crate::param_text::{
     format_bend_range, format_db, format_factor, format_semitones, format_velocity_curve, parse_db,
     parse_factor, parse_semitones, parse_switch, parse_velocity_curve,
 };
+use crate::state::{CompareField, FormatField};
 use nice_plug::prelude::*;
 use ressort_engine::instrument::controls::A4_RANGE_HZ;
 use ressort_engine::instrument::Controls;
@@ -37,6 +38,14 @@ pub struct RessortParams {
     /// Which MIDI controller moves which macro slot (MIDI learn; saved with the project).
     #[persist = "cc_map"]
     pub cc_map: Arc<CcMap>,
+
+    /// The A/B slots (saved with the project).
+    #[persist = "compare"]
+    pub compare: CompareField,
+
+    /// The state's format number: see `state`.
+    #[persist = "format"]
+    pub format: FormatField,
 
     /// × on every K-class argument (log₂ of the factor).
     #[id = "stiffness"]
@@ -185,6 +194,8 @@ impl RessortParams {
         let d = Controls::DEFAULT;
         let voices_store = model.clone();
         RessortParams {
+            compare: CompareField(model.clone()),
+            format: FormatField(model.clone()),
             model,
             cc_map: Arc::new(CcMap::default()),
             stiffness: factor_param("Stiffness").with_poly_modulation_id(POLY_MOD_STIFFNESS),

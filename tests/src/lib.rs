@@ -1609,6 +1609,7 @@ impl Drop for TestPlugin {
 /// Helpers for nice-plug's state format: an 8-byte little-endian length, then JSON
 /// `{"version", "params": {string id: plain value}, "fields": {name: JSON text}}`. Ressort keeps
 /// its model in the field `"model"`: `{"name": …, "script": …}`.
+pub mod fixtures;
 pub mod screen;
 
 pub mod state {
