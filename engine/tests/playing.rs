@@ -757,6 +757,20 @@ fn an_exciter_an_input_cannot_take_is_an_error_at_its_directive() {
     }
 }
 
+/// An empty script (a cleared editor, an empty file, comments only) is refused where it
+/// starts: the language allows it, an instrument has nothing to play in it.
+#[test]
+fn an_empty_script_is_refused() {
+    for script in ["", "\n\n", "# only a comment\n", "~voices 4\n"] {
+        let err = instrument::prepare("empty", script, 48_000.0).unwrap_err();
+        assert!(
+            err.0[0].starts_with("1:1: error: the script is empty"),
+            "{script:?}: {:?}",
+            err.0
+        );
+    }
+}
+
 /// The spectral centroid of the first half second of `signal`, in Hz (Hann window).
 fn attack_centroid(signal: &[f64], sr: f64) -> f64 {
     let n = (0.5 * sr) as usize;

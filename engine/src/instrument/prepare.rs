@@ -126,6 +126,15 @@ pub fn parse_script(text: &str) -> Result<(ModelSpec, HostSettings, Vec<String>)
             "1:1: error: the script describes no model".into()
         ]));
     };
+    // The language allows an empty model; an instrument has nothing to play in one, and a
+    // cleared editor or an empty file must not silence the running model.
+    if spec.elements.is_empty() {
+        return Err(Rejected(vec![
+            "1:1: error: the script is empty: it defines no element to play (write a model, \
+             see docs/LANGUAGE.md, or choose a preset)"
+                .into(),
+        ]));
+    }
     let settings = HostSettings::from_spec(&spec).map_err(Rejected)?;
     Ok((spec, settings, warnings))
 }
