@@ -757,6 +757,38 @@ fn an_exciter_an_input_cannot_take_is_an_error_at_its_directive() {
     }
 }
 
+/// Every preset plays at the lowest and highest rates a host offers without a guard trip:
+/// scripts written at the edge for 44.1 kHz are unstable at 22.05 kHz as written (every
+/// per-sample stiffness four times larger), and the exact limit holds them below it.
+#[test]
+fn every_preset_plays_at_22_05_and_192_khz_without_a_guard_trip() {
+    let mut wrong = Vec::new();
+    for sr in [22_050.0, 192_000.0] {
+        for (name, script) in presets() {
+            let mut p = Player::new(&script, sr);
+            let take = p.note(60, 1.0, 1.0);
+            let finite = take.channels.iter().flatten().all(|v| v.is_finite());
+            println!(
+                "{name:<26} {sr:>8} Hz: peak {:.3}, Stiffness ×{:.3}, {} trip(s)",
+                take.peak(),
+                take.gains.stiffness,
+                take.trips
+            );
+            // (At 192 kHz the Chladni plate's hammer barely sounds, a known fault of its
+            // strike at that rate, docs/NOTES.md: the level is held at 22.05 kHz only.)
+            let silent = sr < 48_000.0 && take.peak() < 1e-3;
+            if take.trips > 0 || !finite || silent {
+                wrong.push(format!(
+                    "{name} at {sr} Hz: {} guard trip(s), finite {finite}, peak {:.3}",
+                    take.trips,
+                    take.peak()
+                ));
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
 /// An empty script (a cleared editor, an empty file, comments only) is refused where it
 /// starts: the language allows it, an instrument has nothing to play in it.
 #[test]

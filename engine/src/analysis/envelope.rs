@@ -133,7 +133,14 @@ impl StabilityEnvelope {
             }
             acc
         };
-        let k_at = gk.min(k_floor);
+        // The stiffness Damping leaves room for; a model that cannot keep its own (unstable
+        // as written at this rate) leaves Damping a tenth of what it can keep.
+        let stiffest = self.max_stiffness(0.0);
+        let k_at = if stiffest < gk.min(k_floor) {
+            0.9 * stiffest
+        } else {
+            gk.min(k_floor)
+        };
         let z_limit = limit(&|e| e.max_damping(k_at));
         let z = gz.min(z_limit * TOLERANCE);
         let k_limit = limit(&|e| e.max_stiffness(z));
@@ -183,13 +190,15 @@ const EXACT_SAMPLES: [f64; 2] = [0.0, 0.5];
 /// (Stiffness, Damping) gain plane, at Damping gains 0 and ½ of the largest stable one and on the
 /// Damping axis. The stable region is convex (the criterion is linear in the gains), so these
 /// chords lie inside it and the clamp stays safe. None where the criterion does not apply (a
-/// negative stiffness or damping in the network) or rejects the model as written: the
-/// Gershgorin envelope remains there.
+/// negative stiffness or damping in the network): the Gershgorin envelope remains there.
+///
+/// A model the criterion rejects as written gets its exact limits too, below unit gains: it
+/// would explode (a script written at the edge for 44.1 kHz and played at 22.05 kHz, where
+/// every per-sample stiffness is four times larger), and the Gershgorin envelope's trust in
+/// the script ([`envelope`]) is meant for the bound's pessimism, not for that.
 pub fn exact_envelope(engine: &mut Engine) -> Option<StabilityEnvelope> {
     let ex = engine.exact_stability();
-    if ex.is_stable(1.0, 1.0) != Some(true) {
-        return None;
-    }
+    ex.is_stable(1.0, 1.0)?;
     // Each limit is a bisection of some fifty sparse factorisations (a second for the largest
     // plates): the two axes at once.
     let (z_max, k_max) = super::concurrent::join(|| ex.max_damping(0.0), || ex.max_stiffness(0.0));
