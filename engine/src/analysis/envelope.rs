@@ -134,8 +134,9 @@ impl StabilityEnvelope {
             acc
         };
         // The stiffness Damping leaves room for; a model that cannot keep its own (unstable
-        // as written at this rate) leaves Damping a tenth of what it can keep.
-        let stiffest = self.max_stiffness(0.0);
+        // as written at this rate, or with these macros) leaves Damping a tenth of what it
+        // can keep.
+        let stiffest = limit(&|e| e.max_stiffness(0.0));
         let k_at = if stiffest < gk.min(k_floor) {
             0.9 * stiffest
         } else {
