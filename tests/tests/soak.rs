@@ -102,38 +102,42 @@ impl Counters {
     }
 }
 
-/// The sidechain of one chunk: one of the kinds a broken or wild signal chain delivers.
-fn sidechain(rng: &mut Rng, frames: usize) -> Stereo {
+/// The sidechain of one chunk: one of the kinds a broken or wild signal chain delivers, and
+/// its name.
+fn sidechain(rng: &mut Rng, frames: usize) -> (Stereo, &'static str) {
     let fill = |v: f32| Stereo {
         left: vec![v; frames],
         right: vec![v; frames],
     };
     match rng.below(9) {
-        0 => fill(f32::NAN),
-        1 => fill(if rng.chance(0.5) {
-            f32::INFINITY
-        } else {
-            f32::NEG_INFINITY
-        }),
-        2 => fill(1.0),
-        3 => fill(-1.0),
-        4 => fill(1e-40),
+        0 => (fill(f32::NAN), "NaN"),
+        1 => {
+            let v = if rng.chance(0.5) {
+                f32::INFINITY
+            } else {
+                f32::NEG_INFINITY
+            };
+            (fill(v), "infinity")
+        }
+        2 => (fill(1.0), "DC +1"),
+        3 => (fill(-1.0), "DC -1"),
+        4 => (fill(1e-40), "subnormal"),
         5 => {
             let mut s = Stereo::silence(frames);
             for (i, v) in s.left.iter_mut().enumerate() {
                 *v = [f32::NAN, 1.0, -1.0, 1e-42, 0.3, f32::INFINITY][(i * 7 + 3) % 6];
             }
             s.right = s.left.clone();
-            s
+            (s, "mixed")
         }
         6 => {
             let mut s = Stereo::silence(frames);
             for v in s.left.iter_mut().chain(s.right.iter_mut()) {
                 *v = (rng.unit() as f32 - 0.5) * 0.6;
             }
-            s
+            (s, "noise")
         }
-        _ => Stereo::silence(frames),
+        _ => (Stereo::silence(frames), "silence"),
     }
 }
 
@@ -146,9 +150,11 @@ fn play(
     params: &[ParamDesc],
     held: &mut Vec<u8>,
     max_block: usize,
-) -> Stereo {
+) -> (Stereo, String) {
     let frames = 1 + rng.below(6_000);
-    let mut score = Score::new().with_sidechain(sidechain(rng, frames));
+    let (side, kind) = sidechain(rng, frames);
+    let mut score = Score::new().with_sidechain(side);
+    let notes_before = c.notes;
     let at = |rng: &mut Rng| rng.below(frames) as u32;
     match rng.below(6) {
         0 => {
@@ -202,7 +208,12 @@ fn play(
     let out = plugin.render_song(frames, &pattern, None, &score);
     c.blocks += out.statuses.len() as u64;
     c.samples += frames as u64;
-    out.audio
+    let what = format!(
+        "{frames} frames in blocks {pattern:?}, sidechain {kind}, {} notes, {} held",
+        c.notes - notes_before,
+        held.len()
+    );
+    (out.audio, what)
 }
 
 fn check_audio(audio: &Stereo, c: &mut Counters, what: &str) {
@@ -365,7 +376,7 @@ fn soak(display: Option<&str>, seed: u64, episodes: u64) -> Counters {
             }
             _ => {}
         }
-        let audio = play(&mut plugin, &mut rng, &mut c, &params, &mut held, max_block);
+        let (audio, chunk) = play(&mut plugin, &mut rng, &mut c, &params, &mut held, max_block);
         check_audio(&audio, &mut c, &what);
         plugin.idle();
         let trips = plugin
@@ -387,7 +398,7 @@ fn soak(display: Option<&str>, seed: u64, episodes: u64) -> Counters {
                 })
                 .collect();
             println!(
-                "  !! guard trip after {what} (episode {episode}, {model:?} at {rate} Hz): {}",
+                "  !! guard trip after {what} (episode {episode}, {model:?} at {rate} Hz), in {chunk}: {}",
                 values.join(", ")
             );
             // The user clears the flag.
