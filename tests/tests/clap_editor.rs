@@ -15,10 +15,11 @@ use std::time::{Duration, Instant};
 
 const DISPLAY_ENV: &str = "RESSORT_TEST_DISPLAY";
 
-/// An oscillator far beyond the stability limit, displaced at rest: its guard trips at once.
+/// An oscillator with a negative stiffness, displaced at rest: it runs away and its guard trips
+/// at once (no clamp can hold a negative stiffness).
 const EXPLODING: &str = "\
-# An oscillator far beyond the stability limit, displaced at rest (guard report test).
-@o osc 1. 1000. 0. 1. 0.
+# An oscillator with a negative stiffness, displaced at rest (guard report test).
+@o osc 1. -2. 0. 1. 0.
 @out1 posOutput @o
 ";
 

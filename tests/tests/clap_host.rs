@@ -1279,12 +1279,13 @@ fn struck_presets_sound_on_a_midi_note() {
     );
 }
 
-/// An unstable model (K/4M = 250, far beyond 1): it explodes at once from its initial
-/// displacement, and again after every reset. The stability clamp keeps the model's own
-/// stiffness, so only the explosion guard can catch it.
+/// An unstable model: an oscillator with a negative stiffness, displaced at rest, runs away at
+/// once and again after every reset. No stiffness gain makes it stable (the exact limit, which
+/// holds a too-stiff model below its own stiffness, does not apply to a negative one), so only
+/// the explosion guard can catch it.
 const EXPLODING: &str = "\
-# An oscillator far beyond the stability limit, displaced at rest (end-to-end guard tests).
-@o osc 1. 1000. 0. 1. 0.
+# An oscillator with a negative stiffness, displaced at rest (end-to-end guard tests).
+@o osc 1. -2. 0. 1. 0.
 @out1 posOutput @o
 ";
 
