@@ -6,34 +6,12 @@
 //! Nothing may panic. The law keywords and their columns come from the table
 //! (`LawKind::ALL`), so a new law is in the test the day it is a row.
 
+mod common;
+
+use common::native::{self, Lcg};
 use proptest::prelude::*;
 use ressort_engine::lanes::{LaneEngine, LANES};
-use ressort_engine::{compile, parse, CompileOptions, Engine, LawKind, ParamId, ScaleClass};
-
-/// A deterministic stream of choices (the case's seed drives the whole script).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> u64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        self.0 >> 33
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        self.next() as usize % n
-    }
-
-    fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
-        &items[self.below(items.len())]
-    }
-
-    fn unit(&mut self) -> f64 {
-        self.next() as f64 / (1u64 << 31) as f64
-    }
-}
+use ressort_engine::{compile, parse, CompileOptions, Engine, LawKind, ScaleClass};
 
 /// Values a law's column may take, by the column's name in the table (`P` and `Q` are
 /// parameters).
@@ -162,89 +140,26 @@ fn random_script(seed: u64) -> String {
     text
 }
 
-fn bits(v: &[f64]) -> Vec<u64> {
-    v.iter().map(|x| x.to_bits()).collect()
-}
-
-fn build(text: &str, jit: bool) -> Option<Engine> {
+/// The script compiled at 48 kHz, `None` when it does not compile (the generator writes valid
+/// scripts; a compile error is a result too, not a panic).
+fn build(text: &str) -> Option<Engine> {
     let spec = parse(text)
         .spec
         .unwrap_or_else(|| panic!("does not parse:\n{text}"));
-    let options = CompileOptions {
-        jit,
-        ..CompileOptions::at(48_000.0)
-    };
-    compile(&spec, &options).ok()
+    compile(&spec, &CompileOptions::at(48_000.0)).ok()
 }
 
-/// The interpreter and the native code through 40 blocks of strikes, noise, gain and
-/// parameter changes and resets. Returns whether native code ran.
+/// The interpreter and the native code through 40 blocks of the scripted life of the `jit`
+/// test ([`native::native_equals_interpreter`]). Returns whether native code ran.
 fn native_equals_interpreter(text: &str, seed: u64) -> bool {
-    let (Some(mut native), Some(mut interpreted)) = (build(text, true), build(text, false)) else {
-        return false;
-    };
-    let ins = native.info().num_inputs();
-    let outs = native.info().num_outputs();
-    let params: Vec<ParamId> = (0..native.info().params.len())
-        .map(|i| ParamId(i as u32))
-        .collect();
-    let mut rng = Lcg(seed ^ 0x9e37_79b9);
-    let mut ran_native = false;
-    for block in 0..40 {
-        let frames = 1 + rng.below(200);
-        let mut input = vec![0.0; ins * frames];
-        match rng.below(4) {
-            0 => input
-                .iter_mut()
-                .for_each(|v| *v = (rng.unit() - 0.5) * 0.01),
-            1 => {
-                for c in 0..ins {
-                    input[c * frames + rng.below(frames)] = -0.02 * rng.unit();
-                }
-            }
-            _ => {}
-        }
-        for e in [&mut native, &mut interpreted] {
-            match block {
-                9 => e.set_class_gain(ScaleClass::Stiffness, 1.7),
-                17 => e.set_class_gain(ScaleClass::Damping, 0.5),
-                29 => e.reset(),
-                _ => {}
-            }
-        }
-        if block % 11 == 5 && !params.is_empty() {
-            let id = params[rng.below(params.len())];
-            let v = native.param(id).unwrap() * (0.5 + rng.unit());
-            native.set_param(id, v).unwrap();
-            interpreted.set_param(id, v).unwrap();
-        }
-        let (mut a, mut b) = (vec![0.0; outs * frames], vec![0.0; outs * frames]);
-        native.apply_pending_changes();
-        ran_native |= native.native_code_bytes().is_some();
-        let ra = native.process(frames, &input, &mut a);
-        let rb = interpreted.process(frames, &input, &mut b);
-        let at = format!("{text}\nblock {block} ({frames} frames)");
-        assert_eq!(bits(&a), bits(&b), "native outputs, {at}");
-        assert_eq!(ra, rb, "native report, {at}");
-        assert_eq!(
-            bits(native.positions()),
-            bits(interpreted.positions()),
-            "native x, {at}"
-        );
-        assert_eq!(
-            bits(native.forces()),
-            bits(interpreted.forces()),
-            "native F, {at}"
-        );
-    }
-    ran_native
+    build(text).is_some() && native::native_equals_interpreter(text, 48_000.0, 40, seed) > 0
 }
 
 /// Every lane of a lane group against a plain engine with the same gains and strikes, 60
 /// blocks of 16 frames. Returns the loudest output sample, `None` when the model does not
 /// run in lanes.
 fn lanes_equal_plain(text: &str, seed: u64) -> Option<f64> {
-    let template = build(text, false)?;
+    let template = build(text)?;
     let mut lanes = LaneEngine::new(&template)?;
     let mut loudest = 0.0f64;
     let mut rng = Lcg(seed ^ 0x5851_f42d);
@@ -342,7 +257,7 @@ fn the_random_scripts_cover_every_path_and_law() {
                 keywords.insert(kind.row().keyword);
             }
         }
-        compiled += build(&text, false).is_some() as usize;
+        compiled += build(&text).is_some() as usize;
         native += native_equals_interpreter(&text, seed) as usize;
         if let Some(loudest) = lanes_equal_plain(&text, seed) {
             lanes += 1;

@@ -1,6 +1,7 @@
 //! The stability envelope: how far the host's Stiffness and Damping gains may go before the
 //! model's coupled (Gershgorin) loads reach the limit of spec §5.2.
 
+use crate::analysis::modes::ExactStability;
 use crate::{Engine, ScaleClass};
 
 /// Stability budget kept free by the Stiffness/Damping clamp: the loads of every mass and
@@ -197,8 +198,7 @@ const EXACT_SAMPLES: [f64; 2] = [0.0, 0.5];
 /// would explode (a script written at the edge for 44.1 kHz and played at 22.05 kHz, where
 /// every per-sample stiffness is four times larger), and the Gershgorin envelope's trust in
 /// the script ([`envelope`]) is meant for the bound's pessimism, not for that.
-pub fn exact_envelope(engine: &mut Engine) -> Option<StabilityEnvelope> {
-    let ex = engine.exact_stability();
+pub fn exact_envelope(ex: &ExactStability) -> Option<StabilityEnvelope> {
     ex.is_stable(1.0, 1.0)?;
     // Each limit is a bisection of some fifty sparse factorisations (a second for the largest
     // plates): the two axes at once.

@@ -238,13 +238,15 @@ pub(crate) fn prepare_uncalibrated(
     // A model the exact criterion rejects as written (a script written at the edge for
     // 44.1 kHz, played at 22.05 kHz) would explode: the Gershgorin envelope is not scaled to
     // trust it then, so that the macro envelopes stay true bounds.
-    let unstable_as_written = engine.exact_stability().is_stable(1.0, 1.0) == Some(false);
-    let gershgorin = if unstable_as_written {
+    let exact = engine.exact_stability();
+    let gershgorin = if exact.is_stable(1.0, 1.0) == Some(false) {
         raw_envelope(&mut engine)
     } else {
         envelope(&mut engine)
     };
-    let envelope = exact_envelope(&mut engine).unwrap_or_else(|| gershgorin.clone());
+    let envelope = exact_envelope(&exact).unwrap_or_else(|| gershgorin.clone());
+    // Its matrices are not needed past here.
+    drop(exact);
     let report = engine.stability();
     let worst_load = worst_load(&report);
     let macros = macro_bindings(&mut engine, &settings);

@@ -1,6 +1,8 @@
 //! Helpers shared by the engine's integration tests.
 #![allow(dead_code)]
 
+pub mod native;
+
 use realfft::RealFftPlanner;
 use ressort_engine::{compile, parse, CompileOptions, Engine, ModelSpec};
 
