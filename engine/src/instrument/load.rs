@@ -1,26 +1,66 @@
 //! Loading a script for the instrument: [`super::prepare`] compiles and analyses it, then
 //! [`super::level`] plays it to set its trims. The level calibration plays the model through
-//! the whole instrument, so it comes after preparation here rather than inside it.
+//! the whole instrument, so it comes after preparation here rather than inside it. A script
+//! analysed before (in this process, or a preset of the shipped table) skips both: its
+//! analyses are kept ([`super::analyses`]).
 
+use super::analyses::{self, Analyses};
 use super::host::Rejected;
 use super::level::calibrate;
-use super::prepare::{prepare_uncalibrated, Conventions, Prepared};
+use super::prepare::{prepare_uncalibrated, Conventions, Prepared, Source, UNITS_BUDGET_S};
 
 /// Compiles a script for a sample rate and derives everything the audio thread needs.
 pub fn prepare(name: &str, text: &str, sample_rate: f64) -> Result<Prepared, Rejected> {
     prepare_with(name, text, sample_rate, Conventions::Musical)
 }
 
-/// [`prepare`] under the given playing conventions: legacy projects get no trims.
+/// [`prepare`] under the given playing conventions: legacy projects get no trims. Takes the
+/// analyses kept for the script when there are some, and keeps those it runs.
 pub fn prepare_with(
     name: &str,
     text: &str,
     sample_rate: f64,
     conventions: Conventions,
 ) -> Result<Prepared, Rejected> {
-    let prepared = prepare_uncalibrated(name, text, sample_rate, conventions)?;
-    Ok(match conventions {
+    let source = match analyses::recall(text, sample_rate, conventions) {
+        Some(kept) => Source::Known(kept),
+        None => Source::Analyse {
+            units_budget_s: UNITS_BUDGET_S,
+        },
+    };
+    let (prepared, source) = prepare_uncalibrated(name, text, sample_rate, conventions, source)?;
+    if let Source::Known(_) = source {
+        return Ok(prepared);
+    }
+    let prepared = finish(prepared, conventions);
+    analyses::remember(text, sample_rate, conventions, Analyses::of(prepared.facts()));
+    Ok(prepared)
+}
+
+/// [`prepare_with`] running every analysis, whatever is kept, with the macro units measured
+/// for at most `units_budget_s` seconds (infinity measures them all): what the shipped table
+/// is made from, and what its test compares it with.
+pub fn prepare_analysed(
+    name: &str,
+    text: &str,
+    sample_rate: f64,
+    conventions: Conventions,
+    units_budget_s: f64,
+) -> Result<Prepared, Rejected> {
+    let (prepared, _) = prepare_uncalibrated(
+        name,
+        text,
+        sample_rate,
+        conventions,
+        Source::Analyse { units_budget_s },
+    )?;
+    Ok(finish(prepared, conventions))
+}
+
+/// The level calibration of a freshly analysed model (legacy projects have none).
+fn finish(prepared: Prepared, conventions: Conventions) -> Prepared {
+    match conventions {
         Conventions::Musical => calibrate(prepared),
         Conventions::Legacy => prepared,
-    })
+    }
 }

@@ -20,6 +20,7 @@
 //! whose controls differ from the previous one's) and notes start a chunk at their own
 //! sample. Nothing here allocates, locks or does I/O after [`Instrument::new`].
 
+pub mod analyses;
 pub mod analysis;
 pub mod controls;
 pub mod dsp;
@@ -42,7 +43,7 @@ pub use controls::Controls;
 pub use events::{Event, Timed};
 pub use gains::Gains;
 pub use host::{HostSettings, InputRole, Rejected};
-pub use load::{prepare, prepare_with};
+pub use load::{prepare, prepare_analysed, prepare_with};
 pub use macros::MacroBinding;
 pub use prepare::{parse_script, peak_frequency, Conventions, Facts, Prepared, Watcher};
 

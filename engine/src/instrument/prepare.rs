@@ -3,6 +3,7 @@
 //! the note input, stability envelopes, macro bindings, the reference pitch, scratch
 //! buffers). The audio thread then only runs a [`Prepared`] model.
 
+use super::analyses::Analyses;
 use super::exciters::{self, Exciter, Gestures};
 use super::host::{HostSettings, InputRole, Rejected};
 use super::macros::{macro_bindings, MacroBinding};
@@ -149,15 +150,27 @@ pub enum Conventions {
     Legacy,
 }
 
+/// Where a preparation takes its analyses' results from.
+#[derive(Clone, Debug)]
+pub(crate) enum Source {
+    /// Runs them, measuring the macro units for at most this long.
+    Analyse { units_budget_s: f64 },
+    /// Kept from an earlier preparation of the same script ([`super::analyses`]); a result
+    /// that does not fit the compiled script (a stale table) is analysed afresh.
+    Known(Arc<Analyses>),
+}
+
 /// Compiles a script for a sample rate and derives everything the audio thread needs, under
 /// the given playing conventions; the level calibration ([`super::level`]) comes after, in
-/// [`super::load`].
+/// [`super::load`], unless the analyses were known. Returns the source the analyses came from
+/// (an analysis where kept results did not fit).
 pub(crate) fn prepare_uncalibrated(
     name: &str,
     text: &str,
     sample_rate: f64,
     conventions: Conventions,
-) -> Result<Prepared, Rejected> {
+    source: Source,
+) -> Result<(Prepared, Source), Rejected> {
     let (spec, settings, _warnings) = parse_script(text)?;
     let mut engine = compile(&spec, &CompileOptions::at(sample_rate))
         .map_err(|e| Rejected(e.0.iter().map(|e| format!("1:1: error: {e}")).collect()))?;
@@ -206,15 +219,106 @@ pub(crate) fn prepare_uncalibrated(
     });
 
     let mut settings = settings;
+    let found = match source {
+        Source::Known(ref kept) => (**kept).clone(),
+        Source::Analyse { units_budget_s } => analyse(
+            &spec,
+            &mut engine,
+            &mut settings,
+            conventions,
+            note_input,
+            &exciters,
+            &roles,
+            units_budget_s,
+        ),
+    };
+    let rate = match spec.sample_rate_mode {
+        SampleRateMode::Scaled => REFERENCE_SAMPLE_RATE_HZ / sample_rate,
+        SampleRateMode::Raw => 1.0,
+    };
+    let num_outputs = info.num_outputs();
+    let mut facts = Facts {
+        exciters,
+        conventions,
+        rest_out: vec![0.0; num_outputs.max(1)],
+        output_trim: 1.0,
+        input_trim: 1.0,
+        num_outputs,
+        routing,
+        rest,
+        note_input,
+        force_scale: rate * rate,
+        strike_scale: rate,
+        macros: Vec::new(),
+        macro_units: Vec::new(),
+        envelope: StabilityEnvelope::default(),
+        macro_envelopes: Vec::new(),
+        macro_reference: StabilityEnvelope::default(),
+        worst_load: (0.0, String::new()),
+        settings,
+        sample_rate,
+        name: name.to_string(),
+        roles,
+    };
+    let fresh = matches!(source, Source::Analyse { .. });
+    if !fresh && !found.fits(&facts, &engine) {
+        return prepare_uncalibrated(
+            name,
+            text,
+            sample_rate,
+            conventions,
+            Source::Analyse {
+                units_budget_s: UNITS_BUDGET_S,
+            },
+        );
+    }
+    // A fresh analysis leaves the trims and rests to the level calibration.
+    let (rest_out, output_trim, input_trim) =
+        (facts.rest_out.clone(), facts.output_trim, facts.input_trim);
+    found.apply(&mut facts);
+    if fresh {
+        (facts.rest_out, facts.output_trim, facts.input_trim) = (rest_out, output_trim, input_trim);
+    }
+    let prepared = Prepared {
+        watcher: None,
+        bank: None,
+        gestures: exciters::AT_REST,
+        held_note: None,
+        strike_hold: 0,
+        awake: conventions == Conventions::Legacy,
+        inputs: vec![0.0; facts.roles.len() * CHUNK],
+        outputs: vec![0.0; num_outputs.max(1) * CHUNK],
+        facts: Arc::new(facts),
+        engine,
+    };
+    Ok((prepared, source))
+}
+
+/// Runs the analyses of a freshly compiled model ([`Source::Analyse`]): the reference pitch
+/// (which also sets `settings`' reference pitch and key), the stability envelopes, the worst
+/// load and the macro units. The rests and trims are left at their defaults for the level
+/// calibration. Leaves the engine's parameters as it found them.
+#[allow(clippy::too_many_arguments)]
+fn analyse(
+    spec: &ModelSpec,
+    engine: &mut Engine,
+    settings: &mut HostSettings,
+    conventions: Conventions,
+    note_input: Option<usize>,
+    exciters: &[Exciter],
+    roles: &[InputRole],
+    units_budget_s: f64,
+) -> Analyses {
+    let sample_rate = engine.sample_rate_hz();
     if settings.reference_pitch_hz.is_none() {
         settings.reference_pitch_hz = match conventions {
-            Conventions::Legacy => reference_pitch(&mut engine, note_input, &roles),
+            Conventions::Legacy => reference_pitch(engine, note_input, roles),
             Conventions::Musical => musical_reference_pitch(
-                &spec,
-                &mut engine,
+                spec,
+                engine,
                 note_input,
-                &exciters,
-                &roles,
+                exciters,
+                roles,
                 sample_rate,
             ),
         };
@@ -232,7 +336,7 @@ pub(crate) fn prepare_uncalibrated(
     }
     // The stability limits hold for a key held down: the `audioParam`s a key presses (a
     // bow's friction) are analysed at their pressed values, and put back after.
-    let pressed = press_audio_params(&mut engine, &exciters);
+    let pressed = press_audio_params(engine, exciters);
     // The exact limit where it applies; the Gershgorin envelope (whose scale the macro
     // envelopes share) otherwise.
     // A model the exact criterion rejects as written (a script written at the edge for
@@ -240,24 +344,24 @@ pub(crate) fn prepare_uncalibrated(
     // trust it then, so that the macro envelopes stay true bounds.
     let exact = engine.exact_stability();
     let gershgorin = if exact.is_stable(1.0, 1.0) == Some(false) {
-        raw_envelope(&mut engine)
+        raw_envelope(engine)
     } else {
-        envelope(&mut engine)
+        envelope(engine)
     };
     let envelope = exact_envelope(&exact).unwrap_or_else(|| gershgorin.clone());
     // Its matrices are not needed past here.
     drop(exact);
     let report = engine.stability();
     let worst_load = worst_load(&report);
-    let macros = macro_bindings(&mut engine, &settings);
+    let macros = macro_bindings(engine, settings);
     let macro_envelopes = macros
         .iter()
         .map(|b| {
             b.as_ref().map(|b| {
                 let _ = engine.set_param(b.param, b.min);
-                let low = raw_envelope(&mut engine);
+                let low = raw_envelope(engine);
                 let _ = engine.set_param(b.param, b.max);
-                let high = raw_envelope(&mut engine);
+                let high = raw_envelope(engine);
                 let _ = engine.set_param(b.param, b.default);
                 engine.apply_pending_changes();
                 (low.scaled(gershgorin.scale), high.scaled(gershgorin.scale))
@@ -269,49 +373,21 @@ pub(crate) fn prepare_uncalibrated(
         let _ = engine.set_param(id, value);
     }
     engine.apply_pending_changes();
-    let macro_units = macro_units(&mut engine, &macros, note_input);
+    let macro_units = macro_units(engine, &macros, note_input, units_budget_s);
 
-    let rate = match spec.sample_rate_mode {
-        SampleRateMode::Scaled => REFERENCE_SAMPLE_RATE_HZ / sample_rate,
-        SampleRateMode::Raw => 1.0,
-    };
-    let num_outputs = info.num_outputs();
-    let facts = Facts {
-        exciters,
-        conventions,
-        rest_out: vec![0.0; num_outputs.max(1)],
-        output_trim: 1.0,
-        input_trim: 1.0,
-        num_outputs,
-        routing,
-        rest,
-        note_input,
-        force_scale: rate * rate,
-        strike_scale: rate,
-        macros,
-        macro_units,
+    Analyses {
+        reference_pitch_hz: settings.reference_pitch_hz,
+        reference_key: settings.reference_key,
         envelope,
         macro_envelopes,
         macro_reference: gershgorin,
         worst_load,
-        settings,
-        sample_rate,
-        name: name.to_string(),
-        roles,
-    };
-    let prepared = Prepared {
-        watcher: None,
-        bank: None,
-        gestures: exciters::AT_REST,
-        held_note: None,
-        strike_hold: 0,
-        awake: conventions == Conventions::Legacy,
-        inputs: vec![0.0; facts.roles.len() * CHUNK],
-        outputs: vec![0.0; num_outputs.max(1) * CHUNK],
-        facts: Arc::new(facts),
-        engine,
-    };
-    Ok(prepared)
+        macro_units,
+        macros,
+        rest_out: Vec::new(),
+        output_trim: 1.0,
+        input_trim: 1.0,
+    }
 }
 
 /// Sets every `audioParam` that a press exciter drives to its value with the key fully
@@ -479,7 +555,7 @@ fn reference_pitch(
 
 /// Time the macro units may take while a model is prepared; slots left when it runs out read
 /// as values.
-const UNITS_BUDGET_S: f64 = 0.25;
+pub(crate) const UNITS_BUDGET_S: f64 = 0.25;
 
 /// The unit of every macro slot ([`super::units`]): frequencies and decays of the reference
 /// mode (the strongest from the note input, or `@in1`, to `@out1`) come from the dense modal
@@ -489,6 +565,7 @@ fn macro_units(
     engine: &mut Engine,
     macros: &[Option<MacroBinding>],
     note_input: Option<usize>,
+    budget_s: f64,
 ) -> Vec<MacroUnit> {
     // The reference mode is measured by the dense analysis only, and needs an output.
     let measurable = engine.info().num_points <= crate::analysis::modes::DENSE_LIMIT
@@ -506,7 +583,7 @@ fn macro_units(
         .map(|b| match b {
             Some(b) => {
                 let p = &params[b.param.0 as usize];
-                if !measurable || started.elapsed().as_secs_f64() > UNITS_BUDGET_S {
+                if !measurable || started.elapsed().as_secs_f64() > budget_s {
                     // Nothing to measure, or out of time: positions still read as positions,
                     // the rest as values.
                     return unit_of(engine, b, p.coordinate, &|_: &mut Engine| None);
