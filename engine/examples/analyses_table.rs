@@ -41,14 +41,22 @@ fn main() {
                 let t = Instant::now();
                 let p = prepare_analysed(name, text, *rate, Conventions::Musical, f64::INFINITY)
                     .unwrap_or_else(|e| panic!("{name} prepares: {e:?}"));
-                eprintln!("{name:<24} {rate:>8} Hz {:7.3} s", t.elapsed().as_secs_f64());
+                eprintln!(
+                    "{name:<24} {rate:>8} Hz {:7.3} s",
+                    t.elapsed().as_secs_f64()
+                );
                 *results[i].lock().unwrap() = Some(Analyses::of(p.facts()));
             });
         }
     });
     let mut table = Table::default();
     for ((name, text, rate), a) in jobs.iter().zip(results) {
-        table.push(name, text, *rate, a.into_inner().unwrap().expect("analysed"));
+        table.push(
+            name,
+            text,
+            *rate,
+            a.into_inner().unwrap().expect("analysed"),
+        );
     }
     eprintln!(
         "{} entries in {:.1} s",
@@ -61,7 +69,10 @@ fn main() {
                       preset, a law or an analysis, run\n\
                       cargo run --release -p ressort-engine --example analyses_table -- --write";
         std::fs::write("models/analyses.txt", table.to_text(header)).expect("writes the table");
-        println!("wrote models/analyses.txt ({} entries)", table.entries.len());
+        println!(
+            "wrote models/analyses.txt ({} entries)",
+            table.entries.len()
+        );
         return;
     }
     let shipped = analyses::shipped();
@@ -77,5 +88,8 @@ fn main() {
             println!("differs: {} at {} Hz", e.name, e.sample_rate);
         }
     }
-    println!("{differ} of {} entries differ from models/analyses.txt", table.entries.len());
+    println!(
+        "{differ} of {} entries differ from models/analyses.txt",
+        table.entries.len()
+    );
 }

@@ -87,8 +87,16 @@ fn play(model: Prepared, sr: f64) -> Vec<u32> {
             .map(|&(t, e)| Timed::new((t - done) as u32, e));
         let host: [Option<&[f32]>; MAX_HOST_INPUTS] = [None; MAX_HOST_INPUTS];
         let c = if done > frames / 2 { &moved } else { &controls };
-        let mut slices: Vec<&mut [f32]> = out.iter_mut().map(|c| &mut c[done..done + len]).collect();
-        inst.process(len, &host, false, &mut evs, c, &mut slices[..2.min(MAX_HOST_OUTPUTS)]);
+        let mut slices: Vec<&mut [f32]> =
+            out.iter_mut().map(|c| &mut c[done..done + len]).collect();
+        inst.process(
+            len,
+            &host,
+            false,
+            &mut evs,
+            c,
+            &mut slices[..2.min(MAX_HOST_OUTPUTS)],
+        );
         done += len;
     }
     out.concat().iter().map(|s| s.to_bits()).collect()

@@ -1610,6 +1610,7 @@ impl Drop for TestPlugin {
 /// `{"version", "params": {string id: plain value}, "fields": {name: JSON text}}`. Ressort keeps
 /// its model in the field `"model"`: `{"name": …, "script": …}`.
 pub mod fixtures;
+pub mod presets;
 pub mod screen;
 
 pub mod state {

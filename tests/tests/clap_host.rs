@@ -6,6 +6,7 @@
 //! Parameter values on the CLAP side are nice-plug's normalized values (0..1); the helpers
 //! below convert the plain values of the plugin's documentation (octaves, semitones, dB).
 
+use ressort_tests::presets::presets;
 use ressort_tests::state;
 use ressort_tests::{
     band_energy_share, cents, oscillator_frequency, peak_frequency, plugin_with_model,
@@ -1150,22 +1151,6 @@ fn process_status_lets_the_host_sleep_only_when_quiet() {
         ProcessStatus::Continue,
         "ringing again after the strike"
     );
-}
-
-/// The presets of `models/`, sorted by name.
-fn presets() -> Vec<(String, String)> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
-    let mut presets: Vec<(String, String)> = std::fs::read_dir(&dir)
-        .expect("models/")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "mdl"))
-        .map(|p| {
-            let name = p.file_stem().unwrap().to_string_lossy().into_owned();
-            (name, std::fs::read_to_string(&p).expect("preset text"))
-        })
-        .collect();
-    presets.sort();
-    presets
 }
 
 /// The largest difference between the left channels of two renders.

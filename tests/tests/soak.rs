@@ -19,6 +19,7 @@
 //! ```
 
 use ressort_tests::fixtures;
+use ressort_tests::presets::presets;
 use ressort_tests::screen::{HostWindow, Xvfb};
 use ressort_tests::{state, thread_count, ClapId, ParamDesc, Score, Stereo, TestPlugin};
 use std::time::{Duration, Instant};
@@ -233,26 +234,6 @@ fn check_audio(audio: &Stereo, c: &mut Counters, what: &str) {
             audio.is_finite()
         );
     }
-}
-
-fn presets() -> Vec<(String, String)> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
-    let mut out: Vec<(String, String)> = std::fs::read_dir(dir)
-        .expect("models/")
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "mdl"))
-        .map(|p| {
-            let name = p
-                .file_stem()
-                .unwrap_or_default()
-                .to_string_lossy()
-                .into_owned();
-            (name, std::fs::read_to_string(&p).expect("a preset"))
-        })
-        .collect();
-    out.sort();
-    out
 }
 
 /// Whether the state's model is `script`.

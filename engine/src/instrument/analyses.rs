@@ -26,10 +26,10 @@
 
 use super::macros::MacroBinding;
 use super::prepare::{Conventions, Facts};
-use super::NUM_MACROS;
-use crate::{Engine, ParamId};
 use super::units::{MacroUnit, UnitTable};
+use super::NUM_MACROS;
 use crate::analysis::envelope::{LoadLine, StabilityEnvelope};
+use crate::{Engine, ParamId};
 use std::collections::VecDeque;
 use std::fmt::Write as _;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -239,12 +239,8 @@ impl Table {
             for (i, m) in a.macro_envelopes.iter().enumerate() {
                 match m {
                     Some((lo, hi)) => {
-                        let _ = writeln!(
-                            s,
-                            "slot {i} {} | {}",
-                            envelope_text(lo),
-                            envelope_text(hi)
-                        );
+                        let _ =
+                            writeln!(s, "slot {i} {} | {}", envelope_text(lo), envelope_text(hi));
                     }
                     None => {
                         let _ = writeln!(s, "slot {i} none");
@@ -364,10 +360,7 @@ fn parse_envelope(words: &[&str]) -> Option<StabilityEnvelope> {
     }
     Some(StabilityEnvelope {
         scale: scale.parse().ok()?,
-        lines: v
-            .chunks(2)
-            .map(|c| LoadLine { k: c[0], z: c[1] })
-            .collect(),
+        lines: v.chunks(2).map(|c| LoadLine { k: c[0], z: c[1] }).collect(),
     })
 }
 
@@ -481,8 +474,14 @@ mod tests {
         let env = |s: f64| StabilityEnvelope {
             scale: s,
             lines: vec![
-                LoadLine { k: 0.1 + s, z: 1e-300 },
-                LoadLine { k: 1.0 / 3.0, z: 0.0 },
+                LoadLine {
+                    k: 0.1 + s,
+                    z: 1e-300,
+                },
+                LoadLine {
+                    k: 1.0 / 3.0,
+                    z: 0.0,
+                },
             ],
         };
         Analyses {
@@ -546,7 +545,12 @@ mod tests {
     fn memory_keeps_the_newest_models() {
         let rate = 12345.0;
         for i in 0..MEMORY_ENTRIES + 3 {
-            remember(&format!("memory test {i}"), rate, Conventions::Musical, sample());
+            remember(
+                &format!("memory test {i}"),
+                rate,
+                Conventions::Musical,
+                sample(),
+            );
         }
         assert!(recall("memory test 0", rate, Conventions::Musical).is_none());
         let last = format!("memory test {}", MEMORY_ENTRIES + 2);

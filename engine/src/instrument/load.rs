@@ -33,7 +33,12 @@ pub fn prepare_with(
         return Ok(prepared);
     }
     let prepared = finish(prepared, conventions);
-    analyses::remember(text, sample_rate, conventions, Analyses::of(prepared.facts()));
+    analyses::remember(
+        text,
+        sample_rate,
+        conventions,
+        Analyses::of(prepared.facts()),
+    );
     Ok(prepared)
 }
 

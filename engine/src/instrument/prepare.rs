@@ -313,14 +313,9 @@ fn analyse(
     if settings.reference_pitch_hz.is_none() {
         settings.reference_pitch_hz = match conventions {
             Conventions::Legacy => reference_pitch(engine, note_input, roles),
-            Conventions::Musical => musical_reference_pitch(
-                spec,
-                engine,
-                note_input,
-                exciters,
-                roles,
-                sample_rate,
-            ),
+            Conventions::Musical => {
+                musical_reference_pitch(spec, engine, note_input, exciters, roles, sample_rate)
+            }
         };
     }
     // Concert pitch: the key whose equal-tempered pitch (A4 = 440 Hz; the A4 control moves
@@ -555,7 +550,7 @@ fn reference_pitch(
 
 /// Time the macro units may take while a model is prepared; slots left when it runs out read
 /// as values.
-pub(crate) const UNITS_BUDGET_S: f64 = 0.25;
+pub const UNITS_BUDGET_S: f64 = 0.25;
 
 /// The unit of every macro slot ([`super::units`]): frequencies and decays of the reference
 /// mode (the strongest from the note input, or `@in1`, to `@out1`) come from the dense modal
