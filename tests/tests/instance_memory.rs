@@ -94,7 +94,12 @@ fn every_preset_instance_stays_lean() {
             Some(id) => (id, true),
             None => (name.as_str(), false),
         };
-        let mut text = presets.iter().find(|p| p.0 == id).expect("a preset").1.clone();
+        let mut text = presets
+            .iter()
+            .find(|p| p.0 == id)
+            .expect("a preset")
+            .1
+            .clone();
         if edited {
             text.push_str("\n# edited\n");
         }
