@@ -21,6 +21,8 @@ use std::sync::Arc;
 
 pub mod editor;
 pub mod files;
+#[cfg(target_os = "linux")]
+pub mod large_blocks;
 pub mod midi_learn;
 pub mod model;
 pub mod modes_view;
@@ -34,6 +36,13 @@ pub mod report;
 pub mod runtime;
 pub mod state;
 pub mod voices_watch;
+
+/// Large blocks (the analyses' matrices) go back to the system when freed
+/// ([`large_blocks`]). Release builds only: debug builds may hold nice-plug's checking
+/// allocator (`assert_process_allocs`) in this place.
+#[cfg(all(target_os = "linux", not(debug_assertions)))]
+#[global_allocator]
+static ALLOCATOR: large_blocks::LargeBlocks = large_blocks::LargeBlocks;
 
 pub use ressort_engine::analysis::envelope;
 pub use ressort_engine::instrument::{dsp, host, macros};
