@@ -35,7 +35,9 @@ use std::fmt::Write as _;
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// The sample rates the shipped table covers (Hz).
-pub const SHIPPED_RATES: [f64; 7] = [22050.0, 44100.0, 48000.0, 88200.0, 96000.0, 176400.0, 192000.0];
+pub const SHIPPED_RATES: [f64; 7] = [
+    22050.0, 44100.0, 48000.0, 88200.0, 96000.0, 176400.0, 192000.0,
+];
 /// How many analysed models the process keeps in memory.
 pub const MEMORY_ENTRIES: usize = 32;
 
