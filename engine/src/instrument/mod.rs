@@ -32,6 +32,7 @@ pub mod level;
 mod load;
 pub mod macros;
 pub mod output;
+pub mod pitch;
 pub mod prepare;
 pub mod trigger;
 pub mod units;

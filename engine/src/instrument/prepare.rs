@@ -7,16 +7,17 @@ use super::analyses::Analyses;
 use super::exciters::{self, Exciter, Gestures};
 use super::host::{HostSettings, InputRole, Rejected};
 use super::macros::{macro_bindings, MacroBinding};
+pub use super::pitch::{concert_key, peak_frequency, reference_mode};
+use super::pitch::{musical_reference_pitch, reference_pitch};
 use super::units::{unit_of, MacroUnit};
 use super::voices::VoiceBank;
 use super::CHUNK;
 use crate::analysis::envelope::{
     envelope, exact_envelope, raw_envelope, worst_load, StabilityEnvelope,
 };
-use crate::analysis::modes::ModalAnalysis;
 use crate::{
-    compile, parse, CompileOptions, Element, ElementKind, Engine, ExciterKind, InputUse, ModelSpec,
-    RouteSource, SampleRateMode, Span, REFERENCE_SAMPLE_RATE_HZ,
+    compile, parse, CompileOptions, Engine, ExciterKind, InputUse, ModelSpec, RouteSource,
+    SampleRateMode, REFERENCE_SAMPLE_RATE_HZ,
 };
 use std::fmt;
 use std::sync::Arc;
@@ -420,102 +421,6 @@ pub fn press_audio_params(engine: &mut Engine, exciters: &[Exciter]) -> Vec<(cra
     old
 }
 
-/// The MIDI key (fractional) whose equal-tempered pitch is `f` Hz, A4 = 440 Hz at key 69.
-pub fn concert_key(f: f64) -> f64 {
-    69.0 + 12.0 * (f / 440.0).log2()
-}
-
-/// The reference pitch under today's conventions: the mode the modal analysis finds from
-/// where a key excites the model (the strike's input, else the point an exciter's avatar
-/// acts on: the bowed or plucked mass), taken down to its fundamental when it is a harmonic
-/// of a lower mode ([`reference_mode`]). Models the analysis cannot read fall back to the
-/// impulse response, as [`reference_pitch`] does.
-fn musical_reference_pitch(
-    spec: &ModelSpec,
-    engine: &mut Engine,
-    note_input: Option<usize>,
-    exciters: &[Exciter],
-    roles: &[InputRole],
-    sample_rate: f64,
-) -> Option<f64> {
-    if engine.info().num_outputs() == 0 {
-        return None;
-    }
-    if let Some(k) = note_input {
-        let a = engine.modes(None);
-        return reference_mode(&a, k + 1).or_else(|| estimate_pitch(engine, note_input, roles));
-    }
-    if exciters.is_empty() {
-        // Nothing for a key to play: a model that plays by itself from rest (a dropped ball)
-        // is heard by how it sounds then.
-        return free_run_pitch(engine, roles);
-    }
-    // A force where the first bow or plectrum acts, on a copy of the model.
-    let contact = exciters.iter().find_map(|x| x.contact.clone());
-    if let Some(target) = contact {
-        let channel = roles.len() as u32 + 1;
-        let mut probe = spec.clone();
-        probe.elements.push(Element {
-            label: crate::spec::Label::new(format!("in{channel}")),
-            kind: ElementKind::FrcInput { channel, target },
-            buffers: Vec::new(),
-            tag_xy: None,
-            span: Span::default(),
-        });
-        let mut options = CompileOptions::at(sample_rate);
-        options.jit = false;
-        if let Ok(mut e) = compile(&probe, &options) {
-            let a = e.modes(None);
-            return reference_mode(&a, channel as usize);
-        }
-        return None;
-    }
-    // A press on a position or force input: the analysis from that input.
-    let k = exciters
-        .iter()
-        .find(|x| matches!(x.role, InputRole::Force | InputRole::Position))?
-        .input;
-    let a = engine.modes(None);
-    reference_mode(&a, k + 1)
-}
-
-/// The reference mode from `input` (1-based) to `@out1`: the strongest mode above 20 Hz, or
-/// the fundamental of the harmonic series it belongs to. A string's strongest mode at the
-/// listening point is often a higher harmonic; its pitch is its fundamental. The fundamental
-/// is the lowest mode f at most 40 dB weaker than the strongest, such that the strongest lies
-/// within 1 % of a whole multiple n·f (n ≥ 2) and a mode lies within 1 % of 2·f: a series, not
-/// two modes of a membrane that happen to fall near a ratio.
-pub fn reference_mode(a: &ModalAnalysis, input: usize) -> Option<f64> {
-    let strongest = a.strongest(input, 1, 20.0)?;
-    let (fs, gs) = (
-        strongest.frequency_hz,
-        strongest
-            .gains
-            .get((input - 1) * a.num_outputs)
-            .copied()
-            .unwrap_or(0.0),
-    );
-    let near = |f: f64, target: f64| (f - target).abs() <= 0.01 * target;
-    let has_mode = |target: f64| a.modes.iter().any(|m| near(m.frequency_hz, target));
-    for (i, m) in a.modes.iter().enumerate() {
-        let f = m.frequency_hz;
-        if f < 20.0 || f >= fs * 0.99 {
-            continue;
-        }
-        let n = (fs / f).round();
-        if n >= 2.0 && near(fs, n * f) && a.gain(i, input, 1) >= 0.01 * gs && has_mode(2.0 * f) {
-            return Some(f);
-        }
-    }
-    Some(fs)
-}
-
-/// The model's reference pitch (issue 14): the strongest mode that `@out1` hears from the note
-/// input, by the modal analysis ([`crate::analysis::modes`]), for models of any size: dense and
-/// exact up to [`crate::analysis::modes::DENSE_LIMIT`] moving points, the strongest of the lowest
-/// [`crate::analysis::modes::DEFAULT_SPARSE_COUNT`] above (about 2 s for the 150 × 150 plate).
-/// Models the analysis cannot read (a note input with no linear path) fall back to the impulse
-/// response's strongest peak ([`estimate_pitch`]), within its work budget.
 /// What each input channel of `engine` holds when nothing feeds it: a position input its
 /// avatar's declared position (so a silent input leaves the avatar where the script puts it),
 /// every other input 0.
@@ -531,21 +436,6 @@ pub fn input_rests(engine: &Engine) -> Vec<f64> {
             _ => 0.0,
         })
         .collect()
-}
-
-fn reference_pitch(
-    engine: &mut Engine,
-    note_input: Option<usize>,
-    roles: &[InputRole],
-) -> Option<f64> {
-    let k = note_input?;
-    if engine.info().num_outputs() == 0 {
-        return None;
-    }
-    if let Some(f) = engine.reference_pitch(k + 1, 1).filter(|f| *f > 0.0) {
-        return Some(f);
-    }
-    estimate_pitch(engine, note_input, roles)
 }
 
 /// Time the macro units may take while a model is prepared; slots left when it runs out read
@@ -588,132 +478,6 @@ fn macro_units(
             None => MacroUnit::Value,
         })
         .collect()
-}
-
-/// Work budget of the pitch estimate, in element-steps: small models get a long window,
-/// models too large for it get none (the tuning law then uses its low-frequency limit).
-const PITCH_BUDGET: f64 = 4e7;
-/// Length of the pitch estimate's impulse response.
-const PITCH_WINDOW: usize = 8192;
-
-/// The model's reference pitch: the strongest spectral peak of `@out1` after a force impulse
-/// on the note input, found by rendering [`PITCH_WINDOW`] samples off the audio thread. The
-/// engine is reset afterwards. None when the model has no force input or output, is too large
-/// for the budget, or does not ring.
-fn estimate_pitch(
-    engine: &mut Engine,
-    note_input: Option<usize>,
-    roles: &[InputRole],
-) -> Option<f64> {
-    let k = note_input?;
-    let info = engine.info();
-    if info.num_outputs() == 0 {
-        return None;
-    }
-    let size = (info.num_points + info.num_interactions).max(1) as f64;
-    if size * PITCH_WINDOW as f64 > PITCH_BUDGET {
-        return None;
-    }
-    let sr = engine.sample_rate_hz();
-    let n_in = roles.len();
-    let n_out = info.num_outputs();
-    let mut inputs = vec![0.0; n_in * CHUNK];
-    let mut outputs = vec![0.0; n_out * CHUNK];
-    let mut signal = Vec::with_capacity(PITCH_WINDOW);
-    inputs[k * CHUNK] = -1e-3;
-    while signal.len() < PITCH_WINDOW {
-        engine.process(CHUNK, &inputs, &mut outputs);
-        inputs.fill(0.0);
-        signal.extend_from_slice(&outputs[..CHUNK]);
-    }
-    let tripped = engine.is_tripped();
-    engine.reset();
-    if tripped {
-        return None;
-    }
-    peak_frequency(&signal, sr)
-}
-
-/// Work budget of the free-run pitch, in element-steps, and its longest window.
-const FREE_RUN_BUDGET: f64 = 1e8;
-const FREE_RUN_SECONDS: f64 = 1.0;
-
-/// The pitch of a model that moves by itself from rest (a ball dropped at every reset, as a
-/// voice of Drunk Triangles): the strongest peak of `@out1` over up to a second of it, its
-/// inputs at rest, within [`FREE_RUN_BUDGET`]. The engine is reset afterwards.
-fn free_run_pitch(engine: &mut Engine, roles: &[InputRole]) -> Option<f64> {
-    let info = engine.info();
-    let n_out = info.num_outputs();
-    if n_out == 0 {
-        return None;
-    }
-    let size = (info.num_points + info.num_interactions).max(1) as f64;
-    let sr = engine.sample_rate_hz();
-    let frames = (FREE_RUN_SECONDS * sr).min(FREE_RUN_BUDGET / size) as usize / CHUNK * CHUNK;
-    if frames < 1024 {
-        return None;
-    }
-    let rest = input_rests(engine);
-    let n_in = roles.len();
-    let mut inputs = vec![0.0; n_in * CHUNK];
-    for (k, r) in rest.iter().enumerate().take(n_in) {
-        inputs[k * CHUNK..(k + 1) * CHUNK].fill(*r);
-    }
-    let mut outputs = vec![0.0; n_out * CHUNK];
-    let mut signal = Vec::with_capacity(frames);
-    while signal.len() < frames {
-        engine.process(CHUNK, &inputs, &mut outputs);
-        signal.extend_from_slice(&outputs[..CHUNK]);
-    }
-    let tripped = engine.is_tripped();
-    engine.reset();
-    let first = signal[0];
-    if tripped || signal.iter().all(|v| *v == first) {
-        return None;
-    }
-    peak_frequency(&signal, sr)
-}
-
-/// The frequency of the strongest peak above 20 Hz (Hann window, parabolic interpolation of
-/// the log magnitude).
-pub fn peak_frequency(signal: &[f64], sample_rate: f64) -> Option<f64> {
-    let n = signal.len();
-    let mean = signal.iter().sum::<f64>() / n as f64;
-    let mut frame: Vec<f64> = signal
-        .iter()
-        .enumerate()
-        .map(|(i, x)| {
-            let w = 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos();
-            (x - mean) * w
-        })
-        .collect();
-    let fft = realfft::RealFftPlanner::<f64>::new().plan_fft_forward(n);
-    let mut spectrum = fft.make_output_vec();
-    fft.process(&mut frame, &mut spectrum).ok()?;
-    let mags: Vec<f64> = spectrum.iter().map(|c| c.norm()).collect();
-    let lo = ((20.0 * n as f64 / sample_rate).ceil() as usize).max(1);
-    let (mut best, mut best_mag) = (0, 0.0);
-    for (i, &m) in mags.iter().enumerate().take(mags.len() - 1).skip(lo) {
-        if m > best_mag {
-            best = i;
-            best_mag = m;
-        }
-    }
-    if !(best_mag > 0.0 && best_mag.is_finite()) {
-        return None;
-    }
-    let (a, b, c) = (
-        mags[best - 1].max(1e-300).ln(),
-        best_mag.ln(),
-        mags[best + 1].max(1e-300).ln(),
-    );
-    let denom = a - 2.0 * b + c;
-    let delta = if denom != 0.0 {
-        0.5 * (a - c) / denom
-    } else {
-        0.0
-    };
-    Some((best as f64 + delta.clamp(-0.5, 0.5)) * sample_rate / n as f64)
 }
 
 impl Prepared {
