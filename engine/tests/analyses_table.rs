@@ -3,32 +3,17 @@
 //! fresh analysis, and a model prepared from kept analyses plays the samples the analysed one
 //! plays.
 
+mod common;
+
+use common::presets;
 use ressort_engine::instrument::analyses::{self, Analyses, SHIPPED_RATES};
 use ressort_engine::instrument::{
     prepare_analysed, prepare_with, Controls, Conventions, Event, Instrument, Prepared, Timed,
     MAX_HOST_INPUTS, MAX_HOST_OUTPUTS,
 };
-use std::path::PathBuf;
 
 const REGENERATE: &str =
     "cargo run --release -p ressort-engine --example analyses_table -- --write";
-
-/// Every preset script of `models/`, by name.
-fn presets() -> Vec<(String, String)> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models");
-    let mut files: Vec<(String, String)> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "mdl"))
-        .map(|p| {
-            let name = p.file_stem().unwrap().to_string_lossy().into_owned();
-            (name, std::fs::read_to_string(&p).unwrap())
-        })
-        .collect();
-    files.sort();
-    files
-}
 
 #[test]
 fn the_shipped_table_covers_every_preset_as_written_today() {

@@ -5,30 +5,12 @@
 
 mod common;
 
-use common::{cents, peak_frequency};
+use common::{cents, peak_frequency, presets};
 use ressort_engine::instrument::dsp::CEILING_KNEE;
 use ressort_engine::instrument::{
     self, Controls, Event, Gains, Instrument, Prepared, Timed, MAX_HOST_INPUTS, MAX_HOST_OUTPUTS,
 };
 use ressort_engine::{ExciterKind, ScaleClass};
-use std::path::PathBuf;
-
-/// Every preset script of `models/`, by name.
-fn presets() -> Vec<(String, String)> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models");
-    let mut files: Vec<(String, String)> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "mdl"))
-        .map(|p| {
-            let name = p.file_stem().unwrap().to_string_lossy().into_owned();
-            (name, std::fs::read_to_string(&p).unwrap())
-        })
-        .collect();
-    files.sort();
-    files
-}
 
 fn preset(name: &str) -> String {
     presets()

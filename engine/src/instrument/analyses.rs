@@ -149,12 +149,6 @@ pub fn remember(text: &str, sample_rate: f64, conventions: Conventions, analyses
     });
 }
 
-/// Forgets every analysis kept in memory (the shipped table stays): for measurements of a
-/// first load.
-pub fn forget() {
-    lock_memory().clear();
-}
-
 struct Kept {
     text: String,
     rate: u64,

@@ -273,13 +273,7 @@ pub(crate) fn prepare_uncalibrated(
             },
         );
     }
-    // A fresh analysis leaves the trims and rests to the level calibration.
-    let (rest_out, output_trim, input_trim) =
-        (facts.rest_out.clone(), facts.output_trim, facts.input_trim);
     found.apply(&mut facts);
-    if fresh {
-        (facts.rest_out, facts.output_trim, facts.input_trim) = (rest_out, output_trim, input_trim);
-    }
     let prepared = Prepared {
         watcher: None,
         bank: None,
@@ -297,8 +291,8 @@ pub(crate) fn prepare_uncalibrated(
 
 /// Runs the analyses of a freshly compiled model ([`Source::Analyse`]): the reference pitch
 /// (which also sets `settings`' reference pitch and key), the stability envelopes, the worst
-/// load and the macro units. The rests and trims are left at their defaults for the level
-/// calibration. Leaves the engine's parameters as it found them.
+/// load and the macro units. The rests and trims are left at their neutral values for the
+/// level calibration. Leaves the engine's parameters as it found them.
 #[allow(clippy::too_many_arguments)]
 fn analyse(
     spec: &ModelSpec,
@@ -380,7 +374,8 @@ fn analyse(
         worst_load,
         macro_units,
         macros,
-        rest_out: Vec::new(),
+        // The level calibration's to measure.
+        rest_out: vec![0.0; engine.info().num_outputs().max(1)],
         output_trim: 1.0,
         input_trim: 1.0,
     }
