@@ -145,10 +145,12 @@ pub struct ModelStatus {
     pub diagnostics: Vec<String>,
     /// The last script that failed, kept for the editor.
     pub rejected: Option<ModelState>,
+    /// `summary.stability` is still to be written from the modal copy ([`ModelStore::status`]).
+    stability_pending: bool,
 }
 
 /// The editor's description of a model.
-pub fn summary(prepared: &mut Prepared) -> ModelSummary {
+pub fn summary(prepared: &Prepared) -> ModelSummary {
     let info = prepared.engine.info();
     let inputs = info
         .inputs
@@ -178,20 +180,6 @@ pub fn summary(prepared: &mut Prepared) -> ModelSummary {
         .collect();
     let params = info.params.iter().map(|p| p.name.clone()).collect();
     let (points, interactions) = (info.num_points, info.num_interactions);
-    // Labelled once, for the mass shown: a state load of the plate would spend 8 ms labelling
-    // 22,000 masses.
-    let report = prepared.engine.stability_numbers();
-    let mut stability: Vec<String> = report.warnings.iter().map(|w| w.to_string()).collect();
-    if let Some(w) = report.worst() {
-        stability.insert(
-            0,
-            format!(
-                "closest to the limit: @{} ({:.1} % of 4M used)",
-                prepared.engine.info().point_label(w.point as usize),
-                100.0 * w.load()
-            ),
-        );
-    }
     ModelSummary {
         name: prepared.facts().name.clone(),
         points,
@@ -201,7 +189,7 @@ pub fn summary(prepared: &mut Prepared) -> ModelSummary {
         params,
         macros: prepared.facts().macros.clone(),
         macro_units: prepared.facts().macro_units.clone(),
-        stability,
+        stability: Vec::new(),
         reference_pitch_hz: prepared.facts().settings.reference_pitch_hz,
         reference_key: prepared.facts().settings.reference_key,
         declared_voices: prepared.facts().settings.voices,
@@ -227,6 +215,23 @@ pub fn summary(prepared: &mut Prepared) -> ModelSummary {
             )
             .collect(),
     }
+}
+
+/// The summary's stability lines ([`ModelSummary::stability`]): the mass closest to its
+/// limit, then the warnings. Labels only the mass shown.
+pub fn stability_lines(modal: &ModalModel) -> Vec<String> {
+    let (report, worst_label) = modal.stability();
+    let mut lines: Vec<String> = report.warnings.iter().map(|w| w.to_string()).collect();
+    if let (Some(w), Some(label)) = (report.worst(), worst_label) {
+        lines.insert(
+            0,
+            format!(
+                "closest to the limit: @{label} ({:.1} % of 4M used)",
+                100.0 * w.load()
+            ),
+        );
+    }
+    lines
 }
 
 /// A/B compare: two scripts, one of them running. A model change goes into the running slot;
@@ -333,9 +338,18 @@ impl ModelStore {
         lock(&self.running).clone()
     }
 
-    /// The running model's summary and the last submission's diagnostics.
+    /// The running model's summary and the last submission's diagnostics. The summary's
+    /// stability lines are worked out at the first call after a load, not in the load: they
+    /// cost the plate's state load 4 ms, and only the editor shows them.
     pub fn status(&self) -> ModelStatus {
-        lock(&self.status).clone()
+        let mut status = lock(&self.status);
+        if status.stability_pending {
+            status.stability_pending = false;
+            if let Some(modal) = lock(&self.modal).clone() {
+                status.summary.stability = stability_lines(&modal);
+            }
+        }
+        status.clone()
     }
 
     /// The value text of macro slot `slot` at position `normalized`: `K = 0.1200`, or
@@ -487,10 +501,13 @@ impl ModelStore {
                 let mut status = lock(&self.status);
                 status.diagnostics.clear();
                 status.rejected = None;
-                if let Some((mut p, reader)) = prepared {
-                    status.summary = summary(&mut p);
-                    drop(status);
+                if let Some((p, reader)) = prepared {
+                    status.summary = summary(&p);
+                    // The modal copy is replaced under the status lock, so that `status`
+                    // never writes the lines of the model before.
                     *lock(&self.modal) = Some(Arc::new(ModalModel::of(&p)));
+                    status.stability_pending = true;
+                    drop(status);
                     *lock(&self.motion) = Some(reader);
                     self.send(Box::new(p));
                 }
@@ -638,7 +655,7 @@ impl ModelStore {
             voices,
             state.playing,
         );
-        let (mut prepared, reader) = match prepared {
+        let (prepared, reader) = match prepared {
             Ok(p) => p,
             Err(rejected) => {
                 let preset = crate::presets::Preset::default_preset();
@@ -658,8 +675,11 @@ impl ModelStore {
                 fallback
             }
         };
-        lock(&self.status).summary = summary(&mut prepared);
+        let mut status = lock(&self.status);
+        status.summary = summary(&prepared);
         *lock(&self.modal) = Some(Arc::new(ModalModel::of(&prepared)));
+        status.stability_pending = true;
+        drop(status);
         *lock(&self.motion) = Some(reader);
         Some(Box::new(prepared))
     }

@@ -447,3 +447,34 @@ fn ab_compare_switches_between_two_scripts() {
     assert_eq!(store.compare().slots, [Some(b.clone()), Some(b)]);
     store.deactivate();
 }
+
+/// The summary's stability lines are written at the first look after a load, from the model
+/// that runs: the mass closest to its limit and its load, as the engine's report has them,
+/// for each of two models loaded one after the other without a look in between.
+#[test]
+fn the_stability_lines_follow_the_running_model() {
+    let store = ModelStore::default();
+    store.activate(48_000.0).expect("the default preset runs");
+    for (name, mass) in [("mesh-15x15", "@mesh["), ("string-1000", "@s[")] {
+        let preset = Preset::find(name).unwrap();
+        store
+            .submit(ModelState::new(preset.id, preset.text))
+            .unwrap();
+        if name == "mesh-15x15" {
+            continue; // not looked at: the string's lines must not be the mesh's
+        }
+        let lines = store.status().summary.stability;
+        let p = prepare(preset.id, preset.text, 48_000.0).unwrap();
+        let mut engine = p.engine.clone();
+        let worst = engine.stability_numbers().worst().expect("a mass").load();
+        let expected = format!("({:.1} % of 4M used)", 100.0 * worst);
+        assert!(
+            lines[0].starts_with(&format!("closest to the limit: {mass}"))
+                && lines[0].ends_with(&expected),
+            "{name}: {lines:?}, expected {expected}"
+        );
+        // Asked again, the same lines.
+        assert_eq!(store.status().summary.stability, lines);
+    }
+    store.deactivate();
+}

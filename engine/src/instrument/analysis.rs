@@ -60,6 +60,18 @@ impl ModalModel {
         self.sample_rate
     }
 
+    /// The stability numbers of the model as written (every gain at 1, spec §5.2), and the
+    /// label of the mass closest to its limit. Works on a copy: the editor's summary asks for
+    /// them once, off the load (the 22,500-mass plate takes 4 ms).
+    pub fn stability(&self) -> (crate::StabilityReport, Option<String>) {
+        let mut engine = self.engine.clone();
+        let report = engine.stability_numbers();
+        let worst = report
+            .worst()
+            .map(|w| engine.info().point_label(w.point as usize));
+        (report, worst)
+    }
+
     /// The Stiffness and Damping gains and macro values the instrument puts on the model for a
     /// note at the reference key with these controls (every smoother at its target), clamped
     /// as when it plays.

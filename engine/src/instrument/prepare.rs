@@ -424,8 +424,9 @@ pub fn input_rests(engine: &Engine) -> Vec<f64> {
     info.inputs
         .iter()
         .map(|uses| match uses.first() {
-            Some(InputUse::Position(label)) => (0..info.num_points)
-                .find(|&i| info.point_label(i) == *label)
+            Some(InputUse::Position(label)) => info
+                .find_point(label)
+                .filter(|&i| i < info.num_points)
                 .map(|i| engine.positions()[i])
                 .unwrap_or(0.0),
             _ => 0.0,

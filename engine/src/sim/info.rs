@@ -105,11 +105,34 @@ impl ModelInfo {
         self.outputs.len()
     }
 
+    /// The point [`ModelInfo::point_label`] names `label`, the first one if several do.
+    /// Formats only the labels of the owners, and of the nodes of a macro whose label starts
+    /// `label` (a state load of the 22,500-mass plate spent 3.7 ms formatting every point's).
+    pub fn find_point(&self, label: &str) -> Option<usize> {
+        let owners: Vec<String> = self.owners.iter().map(|o| o.label.to_string()).collect();
+        self.points.iter().position(|p| {
+            let owner = &owners[p.owner as usize];
+            match p.kind {
+                PointKind::MacroNode { .. } => {
+                    label.len() > owner.len()
+                        && label.starts_with(owner.as_str())
+                        && label.as_bytes()[owner.len()] == b'['
+                        && self.point_label_of(p) == label
+                }
+                _ => owner == label,
+            }
+        })
+    }
+
     /// A readable name for point `i`: `m1`, `s[12]`, `mesh[3,4]`.
     pub fn point_label(&self, i: usize) -> String {
         let Some(p) = self.points.get(i) else {
             return format!("connection point {}", i - self.points.len());
         };
+        self.point_label_of(p)
+    }
+
+    fn point_label_of(&self, p: &PointInfo) -> String {
         let owner = &self.owners[p.owner as usize];
         match p.kind {
             PointKind::MacroNode { .. } if owner.mesh_width > 0 => format!(
@@ -120,6 +143,31 @@ impl ModelInfo {
             ),
             PointKind::MacroNode { .. } => format!("{}[{}]", owner.label, p.node),
             _ => owner.label.to_string(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::compile::{compile, CompileOptions};
+
+    /// `find_point` agrees with formatting every label, for single points, avatars, string
+    /// and mesh nodes, and names nothing else.
+    #[test]
+    fn find_point_names_the_point_its_label_names() {
+        let text = "@m1 mass 1. 0. 0.\n@in1 posInput 1.\n@s string 5 1. 0.1 0.001 0. 0.\n\
+                    @mesh mesh 3 4 1. 0.1 0.001 0. 0.\n@r1 spring @m1 @in1 0.1\n";
+        let spec = crate::parse(text).spec.expect("it parses");
+        let engine = compile(&spec, &CompileOptions::at(48000.0)).expect("it compiles");
+        let info = engine.info();
+        for i in 0..info.points.len() {
+            let label = info.point_label(i);
+            let first = (0..info.points.len()).find(|&j| info.point_label(j) == label);
+            assert_eq!(info.find_point(&label), first, "{label}");
+        }
+        for missing in ["m2", "s[9]", "mesh[", "mesh[3,0]", "", "s"] {
+            let brute = (0..info.points.len()).find(|&j| info.point_label(j) == missing);
+            assert_eq!(info.find_point(missing), brute, "{missing}");
         }
     }
 }
