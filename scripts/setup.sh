@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what Ressort needs on a fresh Debian machine: the system packages of the plugin shell
-# (ALSA, JACK, X11, GL), Python's venv for the VST3 host tests, and the crates of the
-# workspace. Safe to run again: it installs only what is missing.
+# (ALSA, JACK, X11, GL), Python's venv for the VST3 host tests, Ardour for the DAW export
+# test, and the crates of the workspace. Safe to run again: it installs only what is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -21,6 +21,8 @@ packages=(
   # The editor check: a virtual X server and Mesa's software OpenGL.
   xvfb
   libgl1-mesa-dri
+  # A real DAW for the VST3 tests: Ardour 7.3 exports an automated session headlessly.
+  ardour
 )
 # The VST3 host tests run pedalboard and DawDreamer (PyPI) in a virtual environment.
 if ! command -v python3 >/dev/null; then

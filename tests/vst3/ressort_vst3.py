@@ -102,3 +102,30 @@ def clicks(channels: int, frames: int, every: int, value: float) -> np.ndarray:
     audio = np.zeros((channels, frames), dtype=np.float32)
     audio[:, ::every] = value
     return audio
+
+
+def read_float_wav(path: Path) -> tuple[int, np.ndarray]:
+    """The sample rate and samples (frames × channels) of a 32-bit float WAV file. Reads the
+    `data` chunk only: libsndfile's PEAK chunk holds a time stamp, so two exports of the same
+    audio differ as files."""
+    data = Path(path).read_bytes()
+    if data[:4] != b"RIFF" or data[8:12] != b"WAVE":
+        raise ValueError(f"{path}: not a WAV file")
+    pos, fmt, samples = 12, None, None
+    while pos + 8 <= len(data):
+        chunk, size = data[pos:pos + 4], struct.unpack_from("<I", data, pos + 4)[0]
+        body = data[pos + 8:pos + 8 + size]
+        if chunk == b"fmt ":
+            tag, channels, rate, _, _, bits = struct.unpack_from("<HHIIHH", body)
+            if tag == 0xFFFE:  # WAVE_FORMAT_EXTENSIBLE: the format is the subformat's
+                tag = struct.unpack_from("<H", body, 24)[0]
+            fmt = (tag, channels, rate, bits)
+        elif chunk == b"data":
+            samples = body
+        pos += 8 + size + (size & 1)
+    if fmt is None or samples is None:
+        raise ValueError(f"{path}: no fmt or data chunk")
+    tag, channels, rate, bits = fmt
+    if (tag, bits) != (3, 32):
+        raise ValueError(f"{path}: format {tag} with {bits} bits, not 32-bit float")
+    return rate, np.frombuffer(samples, dtype="<f4").reshape(-1, channels)
