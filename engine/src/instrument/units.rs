@@ -127,12 +127,19 @@ pub fn role(engine: &mut Engine, b: &MacroBinding) -> Role {
 /// of it in the low-frequency limit, so log-linear interpolation is close.
 const TABLE_POSITIONS: [f64; 3] = [0.0, 0.5, 1.0];
 
+/// The largest model whose table positions are analysed at once. A dense analysis holds
+/// about three N × N matrices (24 MB for the 1000-mass string): three at once took a
+/// never-seen string's load to a 130 MB peak, one at a time keeps it near 48 MB.
+const CONCURRENT_POINTS: usize = 300;
+
 /// The unit of slot `b`. `reference(engine)` measures the reference mode of the engine as it
 /// stands: (frequency in Hz, T60 in s), or None where the analysis does not apply; it is
-/// called at the [`TABLE_POSITIONS`] for a stiffness or damping, all at once: each is a modal
-/// analysis of up to a few hundred milliseconds, so each but the first runs on its own thread
-/// with its own copy of the engine (a table whose low end fails then costs the other two in
-/// CPU time, not in wall time). The engine is left at the declared value.
+/// called at the [`TABLE_POSITIONS`] for a stiffness or damping, all at once up to
+/// [`CONCURRENT_POINTS`] points: each is a modal analysis of up to a few hundred
+/// milliseconds, so each but the first runs on its own thread with its own copy of the engine
+/// (a table whose low end fails then costs the other two in CPU time, not in wall time).
+/// Larger models measure one position after the other, for their memory. The engine is left
+/// at the declared value.
 pub fn unit_of(
     engine: &mut Engine,
     b: &MacroBinding,
@@ -149,19 +156,23 @@ pub fn unit_of(
             e.apply_pending_changes();
             reference(e).map(pick)
         };
-        // The positions at once: each but the first on its own thread, with its own copy of
-        // the engine.
-        let (mut middle, mut high) = (engine.clone(), engine.clone());
-        let ((v_high, v_middle), v_low) = crate::analysis::concurrent::join(
-            || {
-                crate::analysis::concurrent::join(
-                    || measure(&mut high, TABLE_POSITIONS[2]),
-                    || measure(&mut middle, TABLE_POSITIONS[1]),
-                )
-            },
-            || measure(engine, TABLE_POSITIONS[0]),
-        );
-        let values = [v_low, v_middle, v_high];
+        let values = if engine.info().num_points <= CONCURRENT_POINTS {
+            // The positions at once: each but the first on its own thread, with its own copy
+            // of the engine.
+            let (mut middle, mut high) = (engine.clone(), engine.clone());
+            let ((v_high, v_middle), v_low) = crate::analysis::concurrent::join(
+                || {
+                    crate::analysis::concurrent::join(
+                        || measure(&mut high, TABLE_POSITIONS[2]),
+                        || measure(&mut middle, TABLE_POSITIONS[1]),
+                    )
+                },
+                || measure(engine, TABLE_POSITIONS[0]),
+            );
+            [v_low, v_middle, v_high]
+        } else {
+            TABLE_POSITIONS.map(|n| measure(engine, n))
+        };
         let _ = engine.set_param(b.param, b.default);
         engine.apply_pending_changes();
         let points = TABLE_POSITIONS
