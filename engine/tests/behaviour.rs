@@ -319,6 +319,44 @@ fn class_gain_scales_every_stiffness() {
     assert_eq!(b.class_gain(ScaleClass::Stiffness), 4.0);
 }
 
+/// The guard holds the outputs to the position limit and the points to 10⁸ times it: a hammer
+/// hung on a soft spring, pushed away by a steady force to 2·10⁵ units while the output (a
+/// separate oscillator) rests, plays on; the same push with the outputs on the hammer trips,
+/// and so does a point pushed past the point limit.
+#[test]
+fn a_point_pushed_far_by_a_steady_force_trips_only_when_heard_or_beyond_the_point_limit() {
+    let spec = |heard: bool| {
+        let mut b = ModelBuilder::new();
+        b.raw();
+        b.ground("g", 0.0);
+        b.mass("h", 1.0, 0.0, 0.0);
+        b.spring_damper("s", Endpoint::label("g"), Endpoint::label("h"), 1e-4, 0.01);
+        b.osc("o", 1.0, 0.01, 0.001, 0.0, 0.0);
+        b.frc_input(1, Endpoint::label("h"));
+        b.pos_output(1, Endpoint::label(if heard { "h" } else { "o" }));
+        b.build()
+    };
+    // F/K = 20 / 1e-4 = 2·10⁵: twenty times the output limit, far inside the point limit.
+    let push = vec![vec![20.0; 40_000]];
+    let mut e = engine(&spec(false), 44_100.0);
+    assert_eq!(e.point_limit(), 1e12);
+    render(&mut e, 40_000, 512, &push);
+    assert_eq!(e.guard_event(), None, "an unheard point far away is not a blow-up");
+    let h = e.info().find_point("h").expect("the hammer");
+    assert!(e.positions()[h] > 1.5e5, "{}", e.positions()[h]);
+
+    let mut heard = engine(&spec(true), 44_100.0);
+    render(&mut heard, 40_000, 512, &push);
+    let ev = heard.guard_event().expect("a heard point beyond the limit trips");
+    assert_eq!((ev.kind, ev.output), (GuardKind::Runaway, Some(0)));
+
+    let mut beyond = engine(&spec(false), 44_100.0);
+    beyond.set_position_limit(1e-4); // points to 10⁴
+    render(&mut beyond, 40_000, 512, &push);
+    let ev = beyond.guard_event().expect("a point beyond the point limit trips");
+    assert_eq!((ev.kind, ev.output), (GuardKind::Runaway, None));
+}
+
 #[test]
 fn guard_silences_an_exploding_model_until_reset() {
     // K/M = 5 > 4: numerically unstable (spec §5.1).

@@ -52,9 +52,18 @@ pub(crate) use crate::sim::kernels::links::{Group, Interactions};
 pub(crate) use crate::sim::kernels::macros::{LineMacro, MacroSlots, Macros, MeshMacro};
 pub(crate) use crate::sim::kernels::proxies::Proxies;
 
-/// The default runaway limit on positions and outputs, in model units. Reference models move
-/// by less than a few units.
+/// The default runaway limit on outputs, in model units. Reference models move by less than a
+/// few units.
 pub const DEFAULT_POSITION_LIMIT: f64 = 1.0e4;
+
+/// How many times the position limit a point may travel before the guard trips on it. The
+/// outputs, which reach the ears, are held to the limit itself; a point no output hears is
+/// guarded for the numbers only (10¹² by default, where the model's own motion still has
+/// 10⁻⁴ of resolution). A large steady force on a soft spring moves a point that far without
+/// any instability: a hammer hung on K = 10⁻⁴, pushed away from its membrane by a sidechain's
+/// DC at Force Gain +38 dB, passed 10⁴ in 9 ms and silenced the instrument with a guard trip
+/// while every output was at rest.
+pub const POINT_LIMIT_FACTOR: f64 = 1.0e8;
 
 /// A compiled model and one running copy of it: the immutable model ([`Compiled`], shared by
 /// every copy behind an `Arc`) and this copy's state. Built by [`crate::compile`]. A clone is a
@@ -280,9 +289,15 @@ impl Engine {
         }
     }
 
-    /// The runaway limit on positions and outputs, in model units.
+    /// The runaway limit on outputs, in model units.
     pub fn position_limit(&self) -> f64 {
         self.position_limit
+    }
+
+    /// The runaway limit on the points' positions: [`POINT_LIMIT_FACTOR`] × the position
+    /// limit.
+    pub fn point_limit(&self) -> f64 {
+        self.position_limit * POINT_LIMIT_FACTOR
     }
 
     /// Sets the runaway limit (non-finite or non-positive values are ignored).
@@ -540,7 +555,7 @@ impl Engine {
             }
             if self.guard.is_none() {
                 if let Some((kind, point)) =
-                    guard::scan_positions(&self.points.x, self.position_limit)
+                    guard::scan_positions(&self.points.x, self.point_limit())
                 {
                     self.trip(kind, Some(point), None);
                 }

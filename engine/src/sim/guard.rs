@@ -19,7 +19,8 @@ pub struct GuardEvent {
 pub enum GuardKind {
     /// A position or output became NaN or infinite.
     NonFinite,
-    /// A position or output exceeded [`Engine::position_limit`](crate::Engine::position_limit).
+    /// An output exceeded [`Engine::position_limit`](crate::Engine::position_limit), or a
+    /// point [`Engine::point_limit`](crate::Engine::point_limit).
     Runaway,
 }
 

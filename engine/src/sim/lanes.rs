@@ -639,10 +639,10 @@ impl LaneEngine {
     }
 
     /// Checks every position of every lane at the end of a block: a lane with one beyond the
-    /// position limit, or not a number, trips.
+    /// point limit ([`Engine::point_limit`]), or not a number, trips.
     #[inline(always)]
     fn scan_positions<S: pulp::Simd>(&mut self, o: Ops<S>) {
-        let limit = self.template.position_limit;
+        let limit = self.template.point_limit();
         let mut beyond = Lanes::ZERO;
         for x in &self.x {
             beyond = o.flag_beyond(*x, limit, beyond);
