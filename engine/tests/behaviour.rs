@@ -341,19 +341,27 @@ fn a_point_pushed_far_by_a_steady_force_trips_only_when_heard_or_beyond_the_poin
     let mut e = engine(&spec(false), 44_100.0);
     assert_eq!(e.point_limit(), 1e12);
     render(&mut e, 40_000, 512, &push);
-    assert_eq!(e.guard_event(), None, "an unheard point far away is not a blow-up");
+    assert_eq!(
+        e.guard_event(),
+        None,
+        "an unheard point far away is not a blow-up"
+    );
     let h = e.info().find_point("h").expect("the hammer");
     assert!(e.positions()[h] > 1.5e5, "{}", e.positions()[h]);
 
     let mut heard = engine(&spec(true), 44_100.0);
     render(&mut heard, 40_000, 512, &push);
-    let ev = heard.guard_event().expect("a heard point beyond the limit trips");
+    let ev = heard
+        .guard_event()
+        .expect("a heard point beyond the limit trips");
     assert_eq!((ev.kind, ev.output), (GuardKind::Runaway, Some(0)));
 
     let mut beyond = engine(&spec(false), 44_100.0);
     beyond.set_position_limit(1e-4); // points to 10⁴
     render(&mut beyond, 40_000, 512, &push);
-    let ev = beyond.guard_event().expect("a point beyond the point limit trips");
+    let ev = beyond
+        .guard_event()
+        .expect("a point beyond the point limit trips");
     assert_eq!((ev.kind, ev.output), (GuardKind::Runaway, None));
 }
 

@@ -32,6 +32,11 @@ impl EditorApp {
         egui::ScrollArea::vertical()
             .id_salt("preset-info")
             .show(ui, |ui| {
+                if let Some(category) = p.category() {
+                    ui.label(RichText::new(category).color(Color32::GRAY).small());
+                    ui.label(p.tags().join(" · "));
+                    ui.add_space(4.0);
+                }
                 for key in crate::presets::FIELDS {
                     let text = p.header_field(key);
                     if !text.is_empty() {
