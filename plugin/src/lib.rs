@@ -636,6 +636,52 @@ impl ClapPlugin for Ressort {
         ClapFeature::AudioEffect,
         ClapFeature::Stereo,
     ];
+
+    /// The pages a hardware controller or a host's device panel shows (CLAP remote controls):
+    /// first the model's own eight macros, named after its `param`s in their value text, then
+    /// the instrument's physics, the remaining macros, and how it is played. nice-plug asks for
+    /// them once, when the plugin is made, so they name slots, not the running model's
+    /// parameters.
+    fn remote_controls(&self, context: &mut impl RemoteControlsContext) {
+        let p = &self.params;
+        context.add_section("Model", |section| {
+            section.add_page("Macros", |page| {
+                for slot in &p.macros[..8] {
+                    page.add_param(&slot.value);
+                }
+            });
+        });
+        context.add_section("Instrument", |section| {
+            section.add_page("Physics", |page| {
+                page.add_param(&p.stiffness);
+                page.add_param(&p.damping);
+                page.add_param(&p.tune);
+                page.add_param(&p.release);
+                page.add_param(&p.output_gain);
+                page.add_param(&p.force_gain);
+                page.add_param(&p.position_gain);
+                page.add_param(&p.velocity_curve);
+            });
+        });
+        context.add_section("Model", |section| {
+            section.add_page("More macros", |page| {
+                for slot in &p.macros[8..] {
+                    page.add_param(&slot.value);
+                }
+            });
+        });
+        context.add_section("Playing", |section| {
+            section.add_page("Playing", |page| {
+                page.add_param(&p.a4);
+                page.add_param(&p.bend_range);
+                page.add_param(&p.mpe);
+                page.add_param(&p.voices);
+                page.add_param(&p.trigger);
+                page.add_param(&p.trigger_sensitivity);
+                page.add_param(&p.dc_filter);
+            });
+        });
+    }
 }
 
 impl Vst3Plugin for Ressort {

@@ -12,6 +12,16 @@ pub(crate) struct Extensions {
     audio_ports_config: Option<PluginAudioPortsConfig>,
     note_ports: Option<PluginNotePorts>,
     gui: Option<PluginGui>,
+    remote_controls: Option<PluginRemoteControls>,
+}
+
+/// A CLAP remote-controls page as the host reads it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RemotePage {
+    pub section: String,
+    pub name: String,
+    /// The eight slots: a parameter id, or None for an empty one.
+    pub params: [Option<ClapId>; 8],
 }
 
 /// Host-side buffers of an active plugin, allocated at activation.
@@ -96,6 +106,7 @@ impl TestPlugin {
             audio_ports_config: shared.get_extension(),
             note_ports: shared.get_extension(),
             gui: shared.get_extension(),
+            remote_controls: shared.get_extension(),
         };
         let mut plugin = TestPlugin {
             processor: None,
@@ -643,6 +654,24 @@ impl TestPlugin {
                     max: p.max_value,
                     default: p.default_value,
                     flags: p.flags.bits(),
+                })
+            })
+            .collect()
+    }
+
+    /// The plugin's remote-control pages, in its order (none without the extension).
+    pub fn remote_control_pages(&mut self) -> Vec<RemotePage> {
+        let Some(ext) = self.ext.remote_controls else {
+            return Vec::new();
+        };
+        let handle = self.instance.plugin_handle();
+        let mut buffer = RemoteControlsPageBuffer::new();
+        (0..ext.count(&handle))
+            .filter_map(|i| {
+                ext.get(&handle, i, &mut buffer).map(|p| RemotePage {
+                    section: String::from_utf8_lossy(p.section_name).into_owned(),
+                    name: String::from_utf8_lossy(p.page_name).into_owned(),
+                    params: p.param_ids,
                 })
             })
             .collect()

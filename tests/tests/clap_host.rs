@@ -267,6 +267,71 @@ fn plugin_describes_its_ports_and_parameters() {
 // Activation and audio
 // ---------------------------------------------------------------------------------------------
 
+/// The remote-control pages a controller or a host's device panel shows: the model's eight
+/// macros first, then the instrument's physics, the other eight macros and how it is played,
+/// each slot a parameter the plugin has, none twice.
+#[test]
+fn remote_control_pages_put_the_models_macros_first() {
+    let mut plugin = TestPlugin::new();
+    let pages = plugin.remote_control_pages();
+    let params = plugin.params();
+    let name = |id: Option<ClapId>| {
+        id.map(|id| {
+            params
+                .iter()
+                .find(|p| p.id == id)
+                .unwrap_or_else(|| panic!("page slot {id:?} is no parameter"))
+                .name
+                .clone()
+        })
+    };
+    println!("remote-control pages:");
+    let mut seen = Vec::new();
+    let mut read = Vec::new();
+    for page in &pages {
+        let names: Vec<String> = page
+            .params
+            .iter()
+            .map(|&id| name(id).unwrap_or_default())
+            .collect();
+        println!("  {} / {}: {}", page.section, page.name, names.join(", "));
+        for id in page.params.iter().flatten() {
+            assert!(!seen.contains(id), "{id:?} on two pages");
+            seen.push(*id);
+        }
+        read.push((page.section.as_str(), page.name.as_str(), names));
+    }
+    let macros = |from: usize| {
+        (from..from + 8)
+            .map(|i| format!("Macro {i}"))
+            .collect::<Vec<_>>()
+    };
+    let expect = |list: &[&str]| list.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    assert_eq!(read.len(), 4, "{read:?}");
+    assert_eq!(read[0], ("Model", "Macros", macros(1)));
+    assert_eq!(
+        read[1],
+        (
+            "Instrument",
+            "Physics",
+            expect(&[
+                "Stiffness",
+                "Damping",
+                "Tune",
+                "Release",
+                "Output Gain",
+                "Force Gain",
+                "Position Gain",
+                "Velocity Curve"
+            ])
+        )
+    );
+    assert_eq!(read[2], ("Model", "More macros", macros(9)));
+    assert_eq!((read[3].0, read[3].1), ("Playing", "Playing"));
+    assert_eq!(read[3].2[0], "A4");
+    assert_eq!(read[3].2[7], "", "the last slot of the last page is empty");
+}
+
 #[test]
 fn renders_at_every_sample_rate_and_block_size() {
     let mut plugin = struck_default();
