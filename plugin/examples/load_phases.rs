@@ -4,34 +4,28 @@
 //! `load` is what the host's thread waits for. The stability lines the editor shows are
 //! worked out on its first look, not in the load.
 //!
-//! `cargo run --release -p ressort-plugin --example load_phases` from the workspace root.
+//! `cargo run --release -p ressort-plugin --example load_phases`.
 use ressort_engine::instrument::{self, ModalModel};
 use ressort_plugin::model::{prepare, stability_lines, summary, Playing};
+use ressort_plugin::presets::PRESETS;
 use std::time::Instant;
 
 fn main() {
-    let mut names: Vec<String> = std::fs::read_dir("models")
-        .expect("run from the workspace root")
-        .filter_map(|e| {
-            let p = e.ok()?.path();
-            (p.extension()? == "mdl").then(|| p.file_stem()?.to_str().map(String::from))?
-        })
-        .collect();
-    names.sort();
     println!(
         "| preset | parse (ms) | prepare (ms) | summary (ms) | modal copy (ms) | load (ms) | stability lines (ms) |"
     );
     println!("|---|---:|---:|---:|---:|---:|---:|");
-    for name in names {
-        let text = std::fs::read_to_string(format!("models/{name}.mdl")).expect("a script");
+    let mut presets: Vec<_> = PRESETS.iter().collect();
+    presets.sort_by_key(|p| p.id);
+    for preset in presets {
+        let (name, text) = (preset.id, preset.text);
         let mut best = [f64::MAX; 6];
         for _ in 0..5 {
             let t = Instant::now();
-            let _ = instrument::parse_script(&text).expect("it parses");
+            let _ = instrument::parse_script(text).expect("it parses");
             let parse = t.elapsed().as_secs_f64();
             let t = Instant::now();
-            let (p, _reader) =
-                prepare(&name, &text, 48000.0, 0, Playing::Musical).expect("it loads");
+            let (p, _reader) = prepare(name, text, 48000.0, 0, Playing::Musical).expect("it loads");
             let prep = t.elapsed().as_secs_f64();
             let t = Instant::now();
             let _s = summary(&p);
