@@ -116,3 +116,40 @@ fn extreme_values_in_every_parameter_never_panic_or_hang() {
     );
     assert!(cases > 200, "only {cases} cases");
 }
+
+/// A damped 8 × 8 membrane driving an air mass through a cavity spring, read by dampers to two
+/// grounds (an early kick-drum design): with the head's damping at 0.004 its companion matrix
+/// sent faer's multishift QR into a sort that never ended, so `ressort modes` and every load
+/// of the script spun for ever. The analysis now takes the unblocked QR, and ends.
+#[test]
+fn a_companion_matrix_that_spun_faers_multishift_qr_is_analysed() {
+    let text = "@Head param 0.004\n\
+                @m closedMesh 8 8 1. 0.001063 Head 0.00001 0. 0.\n\
+                @air mass 4. 0. 0.\n@ga ground 0.\n\
+                @helm springDamper @ga @air 0.00025 0.00005\n\
+                @cav spring @air [@m 0.5 0.5] 0.0002\n\
+                @gh ground 0.1\n@h mass 2. 0.1 0.\n\
+                @sh springDamper @gh @h 0.0001 0.05\n\
+                @hit nlContact [@m 0.5 0.5] @h 0.0002 20 0.05 0.002\n\
+                @in1 frcInput @h\n@in2 frcInput [@m 0.5 0.5]\n\
+                @mic1 ground 0.\n@mic2 ground 0.\n\
+                @r1 damper @mic1 @air 0.0006\n@r2 damper @mic1 [@m 0.5 0.5] 0.0005\n\
+                @r3 damper @mic2 @air 0.0006\n@r4 damper @mic2 [@m 0.3 0.6] 0.0005\n\
+                @out1 frcOutput @mic1\n@out2 frcOutput @mic2\n";
+    let (tx, rx) = std::sync::mpsc::channel();
+    let script = text.to_string();
+    std::thread::spawn(move || {
+        let spec = common::spec(&script);
+        let mut engine = common::engine(&spec, 44_100.0);
+        let _ = tx.send(engine.modes(None));
+    });
+    let analysis = rx
+        .recv_timeout(std::time::Duration::from_secs(120))
+        .expect("the modal analysis ends");
+    assert!(analysis.skipped.is_none(), "{:?}", analysis.skipped);
+    assert!(analysis.modes.len() > 30, "{} modes", analysis.modes.len());
+    assert!(analysis
+        .modes
+        .iter()
+        .all(|m| m.frequency_hz.is_finite() && m.frequency_hz > 0.0));
+}

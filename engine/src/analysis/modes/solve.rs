@@ -469,6 +469,77 @@ fn proportional_mode(
     }
 }
 
+/// Matrices up to this order take the unblocked QR (see [`eigen_real`]).
+const UNBLOCKED_LIMIT: usize = 400;
+
+/// The eigenvalues and right eigenvectors of a real matrix, by faer's unblocked double-shift
+/// QR (LAPACK's xLAHQR, at most 30·max(10, n) sweeps, then an error) up to
+/// [`UNBLOCKED_LIMIT`], rather than its multishift QR with aggressive early deflation. That
+/// one's deflation window is sorted by a bubble sort that restarts after every swap of two
+/// Schur blocks; on some companion matrices a 2×2 block swapped forward compares larger again
+/// after the swap's standardisation, and the sort never ends (faer 0.24.4,
+/// `aggressive_early_deflation`: a damped 8 × 8 membrane with an air cavity, 70 points, spun
+/// for ever in `schur_swap_22`). The unblocked QR has no such loop, but its price grows
+/// faster: a damped 138-mass string's `ressort modes` takes 0.12 s against 0.06 s, a 378-mass
+/// one 2.5 s against 0.9 s, and BrokenDown String's unit tables (401 points) 43 s against a few
+/// (release build, Nov 28), so larger matrices keep the multishift QR (docs/NOTES.md). None
+/// when the QR does not converge.
+fn eigen_real(a: &Mat<f64>) -> Option<(Mat<c64>, faer::Col<c64>)> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::evd::{self, ComputeEigenvectors, EvdParams};
+    let n = a.nrows();
+    let mut params: faer::Spec<EvdParams, f64> = Default::default();
+    if n <= UNBLOCKED_LIMIT {
+        params.schur.blocking_threshold = usize::MAX;
+    }
+    let mut u = Mat::<f64>::zeros(n, n);
+    let mut s_re = faer::diag::Diag::<f64>::zeros(n);
+    let mut s_im = faer::diag::Diag::<f64>::zeros(n);
+    let par = faer::Par::Seq;
+    let scratch = evd::evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::Yes,
+        par,
+        params,
+    );
+    let mut buffer = MemBuffer::try_new(scratch).ok()?;
+    evd::evd_real(
+        a.as_ref(),
+        s_re.as_mut(),
+        s_im.as_mut(),
+        None,
+        Some(u.as_mut()),
+        par,
+        MemStack::new(&mut buffer),
+        params,
+    )
+    .ok()?;
+    // Complex pairs are stored as (re, im) column pairs, the first with Im > 0.
+    let mut v = Mat::<c64>::zeros(n, n);
+    let mut s = faer::Col::<c64>::zeros(n);
+    let mut j = 0;
+    while j < n {
+        let im = s_im[j];
+        if im == 0.0 || j + 1 == n {
+            s[j] = c64::new(s_re[j], 0.0);
+            for i in 0..n {
+                v[(i, j)] = c64::new(u[(i, j)], 0.0);
+            }
+            j += 1;
+        } else {
+            s[j] = c64::new(s_re[j], im);
+            s[j + 1] = c64::new(s_re[j], -im);
+            for i in 0..n {
+                v[(i, j)] = c64::new(u[(i, j)], u[(i, j + 1)]);
+                v[(i, j + 1)] = c64::new(u[(i, j)], -u[(i, j + 1)]);
+            }
+            j += 2;
+        }
+    }
+    Some((v, s))
+}
+
 /// The eigenvalues of the 2N companion matrix, with residues (C·v)(w·B)/r from the right
 /// eigenvectors v and the rows w of V⁻¹. Complex eigenvalues with Im r > 0 are listed once per
 /// conjugate pair; real (non-oscillating) roots are not listed.
@@ -487,9 +558,8 @@ fn companion_modes(sys: &System, num_points: usize, sample_rate: f64) -> Option<
         a[(i, n + i)] -= 1.0;
         a[(n + i, i)] = 1.0;
     }
-    let evd = a.eigen().ok()?;
-    let mut v = evd.U().to_owned();
-    repair_repeated_vectors(&a, evd.S().column_vector(), &mut v);
+    let (mut v, s) = eigen_real(&a)?;
+    repair_repeated_vectors(&a, s.as_ref(), &mut v);
     let lu = v.partial_piv_lu();
     // Right-hand sides: [M⁻¹p; 0] and [M⁻¹q; 0] of every input.
     let ni = sys.inputs.len();
@@ -505,7 +575,7 @@ fn companion_modes(sys: &System, num_points: usize, sample_rate: f64) -> Option<
     // Every oscillating root with its output and input coefficients and its shape.
     let mut roots: Vec<Root> = Vec::new();
     for m in 0..2 * n {
-        let r = evd.S().column_vector()[m];
+        let r = s[m];
         if !(r.im > 1e-12 * r.norm().max(1e-300)) {
             continue;
         }
