@@ -168,7 +168,18 @@ pub(crate) fn usage(msg: impl Into<String>) -> Failure {
     Failure::Usage(msg.into())
 }
 
+/// A command piped into `head` ends quietly when the reader goes, as Unix tools do, instead of
+/// panicking in `println!` (Rust's runtime ignores SIGPIPE, so a write fails with EPIPE).
+fn die_on_a_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to its default before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    die_on_a_closed_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Check(a) => check(&a),

@@ -576,3 +576,38 @@ fn bench_sweep_prints_steady_and_swept_costs() {
     let last = text(&out.stdout).lines().last().unwrap().to_string();
     assert!(last.ends_with("voices=2 sweep=1"), "{last}");
 }
+
+/// `ressort modes … | head -1`: the command ends by the broken pipe's signal, quietly, where it
+/// used to panic in `println!` with a backtrace.
+#[cfg(unix)]
+#[test]
+fn a_reader_that_stops_early_ends_the_command_quietly() {
+    use std::io::{BufRead, BufReader};
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::Stdio;
+    let dir = std::env::temp_dir().join(format!("ressort-cli-pipe-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = write(&dir, "string.mdl", STRING_1000);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ressort"))
+        .args(["modes", model.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run ressort");
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert!(first.contains("moving masses"), "{first}");
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.signal(), Some(libc_sigpipe()), "{:?}", out.status);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// SIGPIPE's number on the platforms Ressort builds for.
+#[cfg(unix)]
+fn libc_sigpipe() -> i32 {
+    13
+}
