@@ -42,6 +42,10 @@ pub const REFERENCE_DRUM_DBFS: f64 = -6.0;
 /// The longest level render, in seconds: a bow builds up over a second, and a bouncing ball
 /// can pass its energy on for as long.
 pub const SECONDS: f64 = 1.5;
+/// How long [`note_level`] plays: the two seconds of the level band's check, so that a sound
+/// that keeps growing after the calibration's render (a squeal, a bow that speaks late) is
+/// measured where the band is held.
+pub const NOTE_LEVEL_SECONDS: f64 = 2.0;
 /// The longest drum render.
 const DRUM_SECONDS: f64 = 0.3;
 /// Element-steps (points + interactions, times samples) a render may take.
@@ -184,11 +188,50 @@ fn rest_outputs(p: &mut Prepared) -> Vec<f64> {
 /// inputs), and returns it at rest with the peak of its outputs (the main pair and the
 /// auxiliary ones) at unit gain.
 fn peak(p: Prepared, frames: usize, note: bool, drum: Option<(&[f32], u16)>) -> (Prepared, f64) {
+    let (p, loudest, _) = peak_at(p, frames, note, drum, &Controls::DEFAULT);
+    (p, loudest)
+}
+
+/// The measuring note (C4 at velocity 0.8, from rest: the model is reset first) played with
+/// `controls` for [`NOTE_LEVEL_SECONDS`] (shortened for large models to [`WORK_BUDGET`]):
+/// the model back at rest, the peak a host would hear at the controls' Output Gain before the soft
+/// ceiling (dBFS; −240 for silence), and the guard's trips. Vary measures its variations by it
+/// ([`super::vary::vary_playable`]).
+pub fn note_level(p: Prepared, controls: &Controls) -> (Prepared, f64, u32) {
+    // From rest, whatever the model played before.
+    let mut p = p;
+    p.engine.reset();
+    p.rest_gestures();
+    if let Some(b) = p.bank.as_mut() {
+        b.clear();
+    }
+    let size = (p.engine.info().num_points + p.engine.info().num_interactions).max(1) as f64;
+    let frames =
+        (NOTE_LEVEL_SECONDS * p.facts.sample_rate).min((WORK_BUDGET / size).max(1.0)) as usize;
+    let (p, loudest, trips) = peak_at(p, frames, true, None, controls);
+    let db = if loudest > SILENT && loudest.is_finite() {
+        20.0 * loudest.log10() + controls.output_db
+    } else {
+        -240.0
+    };
+    (p, db, trips)
+}
+
+/// [`peak`] with `controls` (their Output Gain replaced by the measuring gain) and the guard's
+/// trips.
+fn peak_at(
+    p: Prepared,
+    frames: usize,
+    note: bool,
+    drum: Option<(&[f32], u16)>,
+    controls: &Controls,
+) -> (Prepared, f64, u32) {
     let sr = p.facts.sample_rate;
     let controls = Controls {
         output_db: MEASURE_GAIN_DB,
-        ..Controls::DEFAULT
+        ..*controls
     };
+    let mut trips = 0;
     let mut inst = Instrument::new(sr, controls);
     inst.set_model(Box::new(p));
     const BLOCK: usize = 256;
@@ -215,7 +258,7 @@ fn peak(p: Prepared, frames: usize, note: bool, drum: Option<(&[f32], u16)>) -> 
             }
         }
         let mut out: [&mut [f32]; MAX_HOST_OUTPUTS] = buffers.each_mut().map(|b| &mut b[..len]);
-        inst.process(
+        let report = inst.process(
             len,
             &host,
             false,
@@ -223,6 +266,7 @@ fn peak(p: Prepared, frames: usize, note: bool, drum: Option<(&[f32], u16)>) -> 
             &controls,
             &mut out[..channels],
         );
+        trips += report.trips;
         for b in &buffers[..channels] {
             for s in &b[..len] {
                 loudest = loudest.max(s.abs());
@@ -245,7 +289,7 @@ fn peak(p: Prepared, frames: usize, note: bool, drum: Option<(&[f32], u16)>) -> 
     p.engine.reset();
     p.rest_gestures();
     let gain = 10f64.powf(MEASURE_GAIN_DB / 20.0);
-    (p, loudest as f64 / gain)
+    (p, loudest as f64 / gain, trips)
 }
 
 /// The reference kick: a sine gliding from 150 to 45 Hz (30 ms) under an 80 ms decay,

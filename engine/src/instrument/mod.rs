@@ -36,6 +36,7 @@ pub mod pitch;
 pub mod prepare;
 pub mod trigger;
 pub mod units;
+pub mod vary;
 pub mod voices;
 
 pub use crate::analysis::envelope::{LoadLine, StabilityEnvelope, STABILITY_HEADROOM};
@@ -53,6 +54,7 @@ use controls::{ClampView, Smoothed};
 use events::Modulated;
 use gains::{ControlsKey, TuneKey};
 use output::{OutputStage, Span};
+pub use vary::{vary, vary_playable, Variation, VaryScope};
 pub use voices::{Drive, Ended, VoiceBank, VoiceState};
 
 /// The engine runs in chunks of at most this many samples; gains and macros are updated at

@@ -587,6 +587,20 @@ impl Prepared {
         }
     }
 
+    /// What Vary may move on this model ([`super::vary`]): its bound macro slots, and its
+    /// Stiffness unless keys play it in concert pitch.
+    pub fn vary_scope(&self) -> super::vary::VaryScope {
+        let mut bound = [false; super::NUM_MACROS];
+        for (b, m) in bound.iter_mut().zip(&self.facts.macros) {
+            *b = m.is_some();
+        }
+        super::vary::VaryScope {
+            bound,
+            pitched: self.facts.conventions == Conventions::Musical
+                && !self.facts.settings.unpitched,
+        }
+    }
+
     /// The highest key that sounds in tune at default controls: above it the stability
     /// clamp holds the Stiffness gain a note asks for (the exact law inverted at the
     /// envelope's largest gain). None without a reference pitch or a limit.
