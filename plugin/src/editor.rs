@@ -11,12 +11,14 @@ use crate::files::{
     preset_file_name, read_script, save_script, user_preset_dir, user_presets, FileBrowser,
     UserPreset,
 };
+use crate::library::{Entry, Favourites, Filter};
 use crate::model::{Loaded, ModelState, ModelStatus, ModelStore, NUM_MACROS};
 use crate::modes_view::ModesView;
 use crate::motion::MotionReader;
 use crate::params::RessortParams;
 use crate::plot::{PlotState, ZMode};
-use crate::presets::{Preset, PRESETS};
+#[cfg(test)]
+use crate::presets::Preset;
 use crate::report::{set_guard_with, HostLink};
 use egui::{Color32, RichText, Ui};
 use nice_plug::context::gui::GuiContext;
@@ -31,9 +33,11 @@ use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod browser;
 mod controls_panel;
 mod model_panel;
 mod playing;
+mod vary_panel;
 
 /// The editor's size when first opened, in logical pixels.
 pub const DEFAULT_SIZE: (f32, f32) = (1100.0, 700.0);
@@ -131,7 +135,17 @@ pub struct EditorApp {
     modes: ModesView,
     modes_open: bool,
     tab: Tab,
-    preset: usize,
+    /// The sound library (factory and user presets), the browser's filter, the entry whose
+    /// notes it shows, and the user's favourites.
+    library: Vec<Entry>,
+    filter: Filter,
+    selected: Option<usize>,
+    favourites: Favourites,
+    /// The selected entry was chosen by the keys or the arrows: scroll it into view.
+    scroll_to_selected: bool,
+    /// The script of the entry whose notes the browser shows, by entry key.
+    notes: Option<(String, String)>,
+    vary: vary_panel::VaryState,
     /// The text in the script editor, and the name it will be applied under.
     script: String,
     script_name: String,
@@ -142,8 +156,8 @@ pub struct EditorApp {
     /// The submission being prepared in the background: its number, name and script.
     loading: Option<(u64, String, String)>,
     browser: FileBrowser,
-    /// The user preset folder, its presets (read when the Presets tab opens or after a save),
-    /// and the name typed for the next save.
+    /// The user preset folder, its presets (read when the editor opens, after a save and on
+    /// Refresh), and the name typed for the next save.
     user_dir: Option<PathBuf>,
     user: Vec<UserPreset>,
     save_name: String,
@@ -159,10 +173,6 @@ pub struct EditorApp {
 impl EditorApp {
     pub fn new(params: Arc<RessortParams>, store: Arc<ModelStore>) -> EditorApp {
         let running = store.running();
-        let preset = PRESETS
-            .iter()
-            .position(|p| p.id == running.name)
-            .unwrap_or(0);
         // A script that failed to load (a project saved with a broken script, a bad
         // `--model` file) opens in the script editor with its diagnostics.
         let (script, script_name, tab) = match store.status().rejected {
@@ -170,6 +180,11 @@ impl EditorApp {
             None => (running.script.clone(), running.name.clone(), Tab::Presets),
         };
         let user_dir = user_preset_dir();
+        let user = user_dir.as_deref().map(user_presets).unwrap_or_default();
+        let library = crate::library::entries(&user);
+        let selected = library
+            .iter()
+            .position(|e| !e.is_user() && e.id == running.name);
         EditorApp {
             params,
             script,
@@ -184,11 +199,17 @@ impl EditorApp {
             modes: ModesView::default(),
             modes_open: true,
             tab,
-            preset,
+            favourites: Favourites::load(user_dir.as_deref()),
+            library,
+            filter: Filter::all(),
+            selected,
+            scroll_to_selected: true,
+            notes: None,
+            vary: vary_panel::VaryState::default(),
             message: None,
             loading: None,
             browser: FileBrowser::new(),
-            user: user_dir.as_deref().map(user_presets).unwrap_or_default(),
+            user,
             user_dir,
             save_name: String::new(),
             save_path: String::new(),
@@ -609,6 +630,8 @@ impl NiceEguiApp for EditorApp {
                         self.playing(ui, &status);
                         ui.separator();
                         self.controls(ui, &status);
+                        ui.separator();
+                        self.vary_panel(ui);
                         ui.separator();
                         self.model_status(ui, &status);
                     });

@@ -352,6 +352,19 @@ impl ModelStore {
         status.clone()
     }
 
+    /// The running model's name and the parameter each macro slot is bound to (None for an
+    /// unbound slot), cheaply: what the remote-control pages name.
+    pub fn macro_names(&self) -> (String, Vec<Option<String>>) {
+        let status = lock(&self.status);
+        let s = &status.summary;
+        let names = s
+            .macros
+            .iter()
+            .map(|m| m.as_ref().map(|b| b.name.clone()))
+            .collect();
+        (s.name.clone(), names)
+    }
+
     /// The value text of macro slot `slot` at position `normalized`: `K = 0.1200`, or
     /// `unbound` when the model has fewer parameters.
     pub fn macro_text(&self, slot: usize, normalized: f64) -> String {
@@ -525,6 +538,26 @@ impl ModelStore {
                 Err(rejected)
             }
         }
+    }
+
+    /// The running model prepared again at the active rate, for work beside the audio thread
+    /// (Vary plays its variations on it). The analyses come from the table or the cache, as
+    /// for any model seen before, so this takes milliseconds. None while inactive.
+    pub fn prepare_copy(&self) -> Option<Result<Prepared, Rejected>> {
+        let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
+        if rate <= 0.0 {
+            return None;
+        }
+        let state = self.running();
+        let voices = self.voices();
+        Some(
+            instrument::prepare_with(&state.name, &state.script, rate, state.playing.conventions())
+                .map(|mut p| {
+                    let declared = p.facts().settings.voices.unwrap_or(1) as usize;
+                    p.set_voices(if voices == 0 { declared } else { voices });
+                    p
+                }),
+        )
     }
 
     /// The Voices setting new models are prepared with.

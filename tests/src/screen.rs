@@ -306,6 +306,50 @@ pub fn click(display: &str, window: Window, x: i16, y: i16) -> Result<(), String
     Ok(())
 }
 
+/// Types `text` (lower-case letters, digits, spaces and common punctuation: what the keyboard
+/// map has without a modifier) through the XTEST extension, into the window that has the
+/// keyboard focus.
+pub fn type_text(display: &str, text: &str) -> Result<(), String> {
+    use x11rb::protocol::xproto::{KEY_PRESS_EVENT, KEY_RELEASE_EVENT};
+    use x11rb::protocol::xtest::ConnectionExt as _;
+    use x11rb::wrapper::ConnectionExt as _;
+    let (conn, screen) = x11rb::connect(Some(display)).map_err(|e| e.to_string())?;
+    let root = conn.setup().roots[screen].root;
+    let (min, max) = (conn.setup().min_keycode, conn.setup().max_keycode);
+    let map = conn
+        .get_keyboard_mapping(min, max - min + 1)
+        .map_err(|e| e.to_string())?
+        .reply()
+        .map_err(|e| e.to_string())?;
+    let per = map.keysyms_per_keycode.max(1) as usize;
+    for c in text.chars() {
+        // Latin-1 keysyms are the characters' codes; the first keysym of a key is unshifted.
+        let code = map
+            .keysyms
+            .chunks(per)
+            .position(|syms| syms.first() == Some(&(c as u32)))
+            .map(|i| min + i as u8)
+            .ok_or_else(|| format!("no unshifted key types {c:?}"))?;
+        for kind in [KEY_PRESS_EVENT, KEY_RELEASE_EVENT] {
+            conn.xtest_fake_input(kind, code, 0, root, 0, 0, 0)
+                .map_err(|e| e.to_string())?;
+            conn.flush().map_err(|e| e.to_string())?;
+            std::thread::sleep(Duration::from_millis(40));
+        }
+    }
+    conn.sync().map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// What a screenshot does in the editor before its capture.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    /// A left click at window pixels.
+    Click(i16, i16),
+    /// Keys typed into the focused widget.
+    Type(String),
+}
+
 /// Captures a window's contents (a 24-bit TrueColor window, as Xvfb and baseview make).
 pub fn capture(display: &str, window: Window) -> Result<Image, String> {
     let (conn, _) = x11rb::connect(Some(display)).map_err(|e| e.to_string())?;
@@ -473,8 +517,9 @@ pub fn capture_standalone(
     )
 }
 
-/// [`capture_standalone`], clicking at each of `clicks` (window coordinates, in order, half a
-/// second apart) once the capture would have been taken, and capturing two seconds later.
+/// [`capture_standalone`], then each of `actions` (clicks at window coordinates, typed text;
+/// in order, half a second apart) once the capture would have been taken, and capturing two
+/// seconds later.
 pub fn capture_standalone_after_clicks(
     standalone: &Path,
     display: &str,
@@ -482,7 +527,7 @@ pub fn capture_standalone_after_clicks(
     audition: bool,
     until_motion: bool,
     max_wait: Duration,
-    clicks: &[(i16, i16)],
+    actions: &[Action],
 ) -> Result<Capture, String> {
     let log = std::env::temp_dir().join(format!(
         "ressort-standalone-{}-{}.log",
@@ -549,9 +594,12 @@ pub fn capture_standalone_after_clicks(
                 plot_seen.is_some_and(|t| t.elapsed() >= SETTLE)
             };
             if done || shown.elapsed() >= max_wait {
-                if !clicks.is_empty() {
-                    for &(x, y) in clicks {
-                        click(display, window, x, y)?;
+                if !actions.is_empty() {
+                    for action in actions {
+                        match action {
+                            Action::Click(x, y) => click(display, window, *x, *y)?,
+                            Action::Type(text) => type_text(display, text)?,
+                        }
                         std::thread::sleep(Duration::from_millis(500));
                     }
                     std::thread::sleep(SETTLE);

@@ -1,60 +1,11 @@
-//! The model panel's tabs: the presets (built in and the user's), the file browser and the
-//! script editor with its diagnostics. Each loads a model only through
+//! The model panel's tabs besides the browser (`browser.rs`): the user preset folder, the file
+//! browser and the script editor with its diagnostics. Each loads a model only through
 //! [`EditorApp::submit`], so a script with errors never replaces the running one.
 
 use super::*;
 
 impl EditorApp {
-    pub(super) fn presets_tab(&mut self, ui: &mut Ui) {
-        let mut load = None;
-        egui::ScrollArea::vertical()
-            .id_salt("presets")
-            .max_height(ui.available_height() * 0.5)
-            .show(ui, |ui| {
-                for (i, p) in PRESETS.iter().enumerate() {
-                    let r = ui.selectable_label(self.preset == i, p.id);
-                    if r.clicked() {
-                        self.preset = i;
-                    }
-                    if r.double_clicked() {
-                        load = Some(i);
-                    }
-                }
-            });
-        ui.separator();
-        let p = &PRESETS[self.preset.min(PRESETS.len() - 1)];
-        ui.horizontal(|ui| {
-            ui.label(RichText::new(p.id).strong());
-            if ui.button("Load").clicked() {
-                load = Some(self.preset);
-            }
-        });
-        egui::ScrollArea::vertical()
-            .id_salt("preset-info")
-            .show(ui, |ui| {
-                if let Some(category) = p.category() {
-                    ui.label(RichText::new(category).color(Color32::GRAY).small());
-                    ui.label(p.tags().join(" · "));
-                    ui.add_space(4.0);
-                }
-                for key in crate::presets::FIELDS {
-                    let text = p.header_field(key);
-                    if !text.is_empty() {
-                        ui.label(RichText::new(key).color(Color32::GRAY).small());
-                        ui.label(text);
-                        ui.add_space(4.0);
-                    }
-                }
-            });
-        if let Some(i) = load {
-            let p: &Preset = &PRESETS[i];
-            self.submit(p.id.to_string(), p.text.to_string());
-        }
-        ui.separator();
-        self.user_presets(ui);
-    }
-
-    /// The user preset folder: its scripts, and saving the running one there.
+    /// The user preset folder, and saving the running script there.
     pub(super) fn user_presets(&mut self, ui: &mut Ui) {
         let Some(dir) = self.user_dir.clone() else {
             ui.colored_label(ORANGE, "No user data folder on this system");
@@ -62,8 +13,12 @@ impl EditorApp {
         };
         ui.horizontal(|ui| {
             ui.label(RichText::new("User presets").strong());
-            if ui.small_button("Refresh").clicked() {
-                self.user = user_presets(&dir);
+            if ui
+                .small_button("Refresh")
+                .on_hover_text("Read the folder again: its presets join the list above")
+                .clicked()
+            {
+                self.refresh_library();
             }
         });
         ui.label(
@@ -71,24 +26,6 @@ impl EditorApp {
                 .small()
                 .color(Color32::GRAY),
         );
-        let mut open = None;
-        egui::ScrollArea::vertical()
-            .id_salt("user-presets")
-            .max_height(120.0)
-            .show(ui, |ui| {
-                if self.user.is_empty() {
-                    ui.label(RichText::new("none yet").small().color(Color32::GRAY));
-                }
-                for p in &self.user {
-                    if ui
-                        .selectable_label(false, &p.name)
-                        .on_hover_text("Click to load")
-                        .clicked()
-                    {
-                        open = Some(p.clone());
-                    }
-                }
-            });
         ui.horizontal(|ui| {
             ui.add(
                 egui::TextEdit::singleline(&mut self.save_name)
@@ -108,7 +45,7 @@ impl EditorApp {
                         match save_script(&path, &running.script) {
                             Ok(()) => {
                                 self.message = Some((format!("saved {}", path.display()), GREEN));
-                                self.user = user_presets(&dir);
+                                self.refresh_library();
                             }
                             Err(e) => self.message = Some((e, RED)),
                         }
@@ -116,12 +53,6 @@ impl EditorApp {
                 }
             }
         });
-        if let Some(p) = open {
-            match read_script(&p.path) {
-                Ok(text) => self.submit(p.name, text),
-                Err(e) => self.message = Some((e, RED)),
-            }
-        }
     }
 
     pub(super) fn file_tab(&mut self, ui: &mut Ui) {

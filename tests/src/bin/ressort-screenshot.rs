@@ -3,11 +3,12 @@
 //!
 //! ```text
 //! ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest]
-//!                    [--click X,Y]...
+//!                    [--click X,Y | --type TEXT]...
 //! ```
 //!
-//! Each `--click X,Y` clicks the editor at those window coordinates (in order) once the
-//! capture would have been taken; the capture follows two seconds later.
+//! Each `--click X,Y` clicks the editor at those window coordinates and each `--type TEXT`
+//! types into the widget that has the keyboard (lower-case letters, digits, spaces), in the
+//! order given, once the capture would have been taken; the capture follows two seconds later.
 //!
 //! By default the model is struck every second (`--audition`) and the capture is taken as soon
 //! as the motion view shows motion (within S seconds of the window appearing, default 20);
@@ -19,7 +20,9 @@
 //! `main` so their guards drop, and the kernel stops them if it is killed (see
 //! `screen::ChildGuard`).
 
-use ressort_tests::screen::{capture_standalone_after_clicks, shows_motion, standalone_path, Xvfb};
+use ressort_tests::screen::{
+    capture_standalone_after_clicks, shows_motion, standalone_path, Action, Xvfb,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -28,7 +31,7 @@ fn main() -> ExitCode {
     ExitCode::from(run())
 }
 
-const USAGE: &str = "usage: ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest] [--click X,Y]...";
+const USAGE: &str = "usage: ressort-screenshot [--model NAME] [--out FILE.png] [--standalone PATH] [--seconds S] [--at-rest] [--click X,Y | --type TEXT]...";
 
 fn run() -> u8 {
     let mut model = "mesh-25x20".to_string();
@@ -36,7 +39,7 @@ fn run() -> u8 {
     let mut standalone = standalone_path();
     let mut seconds = 20.0;
     let mut at_rest = false;
-    let mut clicks: Vec<(i16, i16)> = Vec::new();
+    let mut actions: Vec<Action> = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         if a == "--at-rest" {
@@ -45,7 +48,7 @@ fn run() -> u8 {
         }
         if !matches!(
             a.as_str(),
-            "--model" | "--out" | "--standalone" | "--seconds" | "--click"
+            "--model" | "--out" | "--standalone" | "--seconds" | "--click" | "--type"
         ) {
             eprintln!("{USAGE}");
             return 2;
@@ -62,12 +65,13 @@ fn run() -> u8 {
                 .split_once(',')
                 .and_then(|(x, y)| Some((x.trim().parse().ok()?, y.trim().parse().ok()?)))
             {
-                Some(xy) => clicks.push(xy),
+                Some((x, y)) => actions.push(Action::Click(x, y)),
                 None => {
                     eprintln!("ressort-screenshot: --click takes X,Y (window pixels)");
                     return 2;
                 }
             },
+            "--type" => actions.push(Action::Type(value)),
             _ => match value.parse() {
                 Ok(s) => seconds = s,
                 Err(_) => {
@@ -95,7 +99,7 @@ fn run() -> u8 {
         !at_rest,
         !at_rest,
         Duration::from_secs_f64(seconds),
-        &clicks,
+        &actions,
     ) {
         Ok(c) => c,
         Err(e) => {
