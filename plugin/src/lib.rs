@@ -23,6 +23,7 @@ pub mod editor;
 pub mod files;
 #[cfg(target_os = "linux")]
 pub mod large_blocks;
+pub mod library;
 pub mod midi_learn;
 pub mod model;
 pub mod modes_view;
@@ -35,6 +36,7 @@ pub mod presets;
 pub mod report;
 pub mod runtime;
 pub mod state;
+pub mod vary_worker;
 pub mod voices_watch;
 
 /// Large blocks (the analyses' matrices) go back to the system when freed
@@ -168,8 +170,9 @@ impl Ressort {
         }
     }
 
-    /// Picks up a new model from the store and starts the crossfade. Realtime-safe.
-    fn receive_models(&mut self) {
+    /// Picks up a new model from the store and starts the crossfade; tells the main thread,
+    /// so that the host's remote-control pages follow it. Realtime-safe.
+    fn receive_models(&mut self, context: &mut impl ProcessContext<Self>) {
         for i in 0..self.held.len() {
             if let Some(p) = self.held[i].take() {
                 if let Err(back) = self.store.recycle(p) {
@@ -195,6 +198,7 @@ impl Ressort {
         self.runtime()
             .running_generation
             .fetch_add(1, Ordering::AcqRel);
+        context.execute_gui(MainThreadTask::ModelChanged);
     }
 
     /// The parameters as the instrument's controls.
@@ -467,6 +471,7 @@ impl Plugin for Ressort {
         Box::new(move |task| match task {
             MainThreadTask::ReportGuardTrip => link.set_guard(&params, true),
             MainThreadTask::ApplyVoices => store.apply_voices(),
+            MainThreadTask::ModelChanged => {}
         })
     }
 
@@ -516,7 +521,7 @@ impl Plugin for Ressort {
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
         let started = std::time::Instant::now();
-        self.receive_models();
+        self.receive_models(context);
         self.editor_requests();
         self.instrument.set_watching(self.editor_state.is_open());
         let frames = buffer.samples();
@@ -637,39 +642,69 @@ impl ClapPlugin for Ressort {
         ClapFeature::Stereo,
     ];
 
-    /// The pages a hardware controller or a host's device panel shows (CLAP remote controls):
-    /// first the model's own eight macros, named after its `param`s in their value text, then
-    /// the instrument's physics, the remaining macros, and how it is played. nice-plug asks for
-    /// them once, when the plugin is made, so they name slots, not the running model's
-    /// parameters.
+    /// The pages a hardware controller or a host's device panel shows (CLAP remote controls),
+    /// for the running model: first a page named after it with its bound macro slots (whose
+    /// value text names their `param`s) and, where fewer than eight are bound, the physics
+    /// (Stiffness, Damping, Release, Output Gain, Tune, Force Gain, Position Gain, Velocity
+    /// Curve); then the physics that did not fit, the bound slots beyond the eighth, and how it
+    /// is played. Unbound slots do nothing and are on no page. The vendored CLAP wrapper asks
+    /// again after a state load and after each main-thread task (the audio thread posts one
+    /// when a new model starts) and tells the host when the pages changed (vendor/README.md).
     fn remote_controls(&self, context: &mut impl RemoteControlsContext) {
         let p = &self.params;
+        let (model, names) = self.store.macro_names();
+        let bound: Vec<usize> = (0..model::NUM_MACROS)
+            .filter(|&i| names.get(i).is_some_and(|n| n.is_some()))
+            .collect();
+        let physics: [&FloatParam; 8] = [
+            &p.stiffness,
+            &p.damping,
+            &p.release,
+            &p.output_gain,
+            &p.tune,
+            &p.force_gain,
+            &p.position_gain,
+            &p.velocity_curve,
+        ];
+        let first = bound.len().min(8);
+        let fill = 8 - first;
+        let title: String = if bound.is_empty() {
+            model.clone()
+        } else {
+            let list: Vec<&str> = bound[..first]
+                .iter()
+                .filter_map(|&i| names[i].as_deref())
+                .collect();
+            format!("{model}: {}", list.join(", "))
+        };
         context.add_section("Model", |section| {
-            section.add_page("Macros", |page| {
-                for slot in &p.macros[..8] {
-                    page.add_param(&slot.value);
+            section.add_page(title.as_str(), |page| {
+                for &i in &bound[..first] {
+                    page.add_param(&p.macros[i].value);
+                }
+                for param in &physics[..fill] {
+                    page.add_param(*param);
                 }
             });
         });
-        context.add_section("Instrument", |section| {
-            section.add_page("Physics", |page| {
-                page.add_param(&p.stiffness);
-                page.add_param(&p.damping);
-                page.add_param(&p.tune);
-                page.add_param(&p.release);
-                page.add_param(&p.output_gain);
-                page.add_param(&p.force_gain);
-                page.add_param(&p.position_gain);
-                page.add_param(&p.velocity_curve);
+        if fill < physics.len() {
+            context.add_section("Instrument", |section| {
+                section.add_page("Physics", |page| {
+                    for param in &physics[fill..] {
+                        page.add_param(*param);
+                    }
+                });
             });
-        });
-        context.add_section("Model", |section| {
-            section.add_page("More macros", |page| {
-                for slot in &p.macros[8..] {
-                    page.add_param(&slot.value);
-                }
+        }
+        if bound.len() > 8 {
+            context.add_section("Model", |section| {
+                section.add_page("More macros", |page| {
+                    for &i in &bound[8..] {
+                        page.add_param(&p.macros[i].value);
+                    }
+                });
             });
-        });
+        }
         context.add_section("Playing", |section| {
             section.add_page("Playing", |page| {
                 page.add_param(&p.a4);

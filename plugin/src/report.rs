@@ -20,6 +20,10 @@ pub enum MainThreadTask {
     ReportGuardTrip,
     /// The Voices setting changed: re-prepare the running model with it.
     ApplyVoices,
+    /// A new model started playing. Nothing to do for the plugin; the CLAP wrapper asks for
+    /// the remote-control pages again after every main-thread task, and they follow the
+    /// model's macros.
+    ModelChanged,
 }
 
 /// The editor's `GuiContext`, kept for main-thread parameter changes.

@@ -129,6 +129,8 @@ pub struct HostCounters {
     pub restarts: u32,
     /// `request_flush` calls seen (the host flushes at the next idle when inactive).
     pub flush_requests: u32,
+    /// `clap_host_remote_controls.changed` calls: the plugin's pages changed.
+    pub remote_controls_changed: u32,
 }
 
 /// The main-thread part of the host.
@@ -192,6 +194,14 @@ impl HostNotePortsImpl for HostMainThread {
     }
 }
 
+impl HostRemoteControlsImpl for HostMainThread {
+    fn changed(&self) {
+        self.count(|c| c.remote_controls_changed += 1);
+    }
+
+    fn suggest_page(&self, _page_id: ClapId) {}
+}
+
 impl HostHandlers for TestHost {
     type Shared<'a> = HostShared;
     type MainThread<'a> = HostMainThread;
@@ -206,6 +216,7 @@ impl HostHandlers for TestHost {
             .register::<HostAudioPortsConfig>()
             .register::<HostNotePorts>()
             .register::<HostThreadCheck>()
+            .register::<HostRemoteControls>()
             .register::<HostGui>();
     }
 }

@@ -42,7 +42,9 @@ use clack_extensions::params::{
     HostParams, HostParamsImplMainThread, HostParamsImplShared, ParamClearFlags, ParamInfoBuffer,
     ParamRescanFlags, PluginParams,
 };
-use clack_extensions::remote_controls::{PluginRemoteControls, RemoteControlsPageBuffer};
+use clack_extensions::remote_controls::{
+    HostRemoteControls, HostRemoteControlsImpl, PluginRemoteControls, RemoteControlsPageBuffer,
+};
 use clack_extensions::state::{HostState, HostStateImpl, PluginState, StateError};
 use clack_extensions::thread_check::{HostThreadCheck, HostThreadCheckImpl};
 use clack_host::events::event_types::{

@@ -267,69 +267,104 @@ fn plugin_describes_its_ports_and_parameters() {
 // Activation and audio
 // ---------------------------------------------------------------------------------------------
 
-/// The remote-control pages a controller or a host's device panel shows: the model's eight
-/// macros first, then the instrument's physics, the other eight macros and how it is played,
-/// each slot a parameter the plugin has, none twice.
+/// The remote-control pages a controller or a host's device panel shows, as a CLAP host reads
+/// them: the running model's own macros first on a page named after it, filled up with the
+/// physics, then the rest; each slot a parameter the plugin has, none twice. They follow the
+/// model: a state load with another model changes them, and the host is told
+/// (`clap_host_remote_controls.changed`).
 #[test]
-fn remote_control_pages_put_the_models_macros_first() {
+fn remote_control_pages_follow_the_running_model() {
     let mut plugin = TestPlugin::new();
-    let pages = plugin.remote_control_pages();
-    let params = plugin.params();
-    let name = |id: Option<ClapId>| {
-        id.map(|id| {
-            params
-                .iter()
-                .find(|p| p.id == id)
-                .unwrap_or_else(|| panic!("page slot {id:?} is no parameter"))
-                .name
-                .clone()
-        })
-    };
-    println!("remote-control pages:");
-    let mut seen = Vec::new();
-    let mut read = Vec::new();
-    for page in &pages {
-        let names: Vec<String> = page
-            .params
-            .iter()
-            .map(|&id| name(id).unwrap_or_default())
-            .collect();
-        println!("  {} / {}: {}", page.section, page.name, names.join(", "));
-        for id in page.params.iter().flatten() {
-            assert!(!seen.contains(id), "{id:?} on two pages");
-            seen.push(*id);
+    plugin.activate(48_000.0, 1, 512);
+    plugin.render(0.05, 512, &Score::new());
+    plugin.idle();
+    let read = |plugin: &mut TestPlugin| -> Vec<(String, String, Vec<String>)> {
+        let params = plugin.params();
+        let name = |id: Option<ClapId>| {
+            id.map(|id| {
+                params
+                    .iter()
+                    .find(|p| p.id == id)
+                    .unwrap_or_else(|| panic!("page slot {id:?} is no parameter"))
+                    .name
+                    .clone()
+            })
+            .unwrap_or_default()
+        };
+        let mut seen = Vec::new();
+        let mut out = Vec::new();
+        for page in plugin.remote_control_pages() {
+            let names: Vec<String> = page.params.iter().map(|&id| name(id)).collect();
+            println!("  {} / {}: {}", page.section, page.name, names.join(", "));
+            for id in page.params.iter().flatten() {
+                assert!(!seen.contains(id), "{id:?} on two pages");
+                seen.push(*id);
+            }
+            out.push((page.section, page.name, names));
         }
-        read.push((page.section.as_str(), page.name.as_str(), names));
-    }
-    let macros = |from: usize| {
-        (from..from + 8)
-            .map(|i| format!("Macro {i}"))
-            .collect::<Vec<_>>()
+        out
     };
     let expect = |list: &[&str]| list.iter().map(|s| s.to_string()).collect::<Vec<_>>();
-    assert_eq!(read.len(), 4, "{read:?}");
-    assert_eq!(read[0], ("Model", "Macros", macros(1)));
+    println!("remote-control pages of the default model:");
+    let mesh = read(&mut plugin);
+    assert_eq!(mesh.len(), 3, "{mesh:?}");
     assert_eq!(
-        read[1],
+        mesh[0],
         (
-            "Instrument",
-            "Physics",
+            "Model".to_string(),
+            "mesh-15x15: K, Z".to_string(),
             expect(&[
+                "Macro 1",
+                "Macro 2",
                 "Stiffness",
                 "Damping",
-                "Tune",
                 "Release",
                 "Output Gain",
-                "Force Gain",
-                "Position Gain",
-                "Velocity Curve"
+                "Tune",
+                "Force Gain"
             ])
         )
     );
-    assert_eq!(read[2], ("Model", "More macros", macros(9)));
-    assert_eq!((read[3].0, read[3].1), ("Playing", "Playing"));
-    assert_eq!(read[3].2[0], "A4");
-    assert_eq!(read[3].2[7], "", "the last slot of the last page is empty");
+    assert_eq!(
+        mesh[1],
+        (
+            "Instrument".to_string(),
+            "Physics".to_string(),
+            expect(&["Position Gain", "Velocity Curve", "", "", "", "", "", ""])
+        )
+    );
+    assert_eq!((mesh[2].0.as_str(), mesh[2].1.as_str()), ("Playing", "Playing"));
+    assert_eq!(mesh[2].2[0], "A4");
+    let changed = plugin.counters().remote_controls_changed;
+
+    let felt = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/felt-piano.mdl"),
+    )
+    .unwrap();
+    let blob = state::with_musical_model(&plugin.save_state(), "felt-piano", &felt);
+    plugin.load_state(&blob).expect("the state loads");
+    plugin.render(0.05, 512, &Score::new());
+    plugin.idle();
+    println!("after loading felt-piano:");
+    let piano = read(&mut plugin);
+    assert_eq!(piano[0].1, "felt-piano: K, K2, Z");
+    assert_eq!(
+        piano[0].2,
+        expect(&[
+            "Macro 1",
+            "Macro 2",
+            "Macro 3",
+            "Stiffness",
+            "Damping",
+            "Release",
+            "Output Gain",
+            "Tune"
+        ])
+    );
+    assert_eq!(piano[1].2[..3], expect(&["Force Gain", "Position Gain", "Velocity Curve"]));
+    let told = plugin.counters().remote_controls_changed - changed;
+    println!("clap_host_remote_controls.changed calls after the load: {told}");
+    assert!(told >= 1, "the host was not told the pages changed");
 }
 
 #[test]

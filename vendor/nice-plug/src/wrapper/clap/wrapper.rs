@@ -35,7 +35,8 @@ use clap_sys::ext::params::{
     clap_plugin_params,
 };
 use clap_sys::ext::remote_controls::{
-    CLAP_EXT_REMOTE_CONTROLS, clap_plugin_remote_controls, clap_remote_controls_page,
+    CLAP_EXT_REMOTE_CONTROLS, clap_host_remote_controls, clap_plugin_remote_controls,
+    clap_remote_controls_page,
 };
 use clap_sys::ext::render::{
     CLAP_EXT_RENDER, CLAP_RENDER_OFFLINE, CLAP_RENDER_REALTIME, clap_plugin_render,
@@ -253,7 +254,10 @@ pub struct Wrapper<P: ClapPlugin> {
 
     clap_plugin_remote_controls: clap_plugin_remote_controls,
     /// The plugin's remote control pages, if it defines any. Filled when initializing the plugin.
-    remote_control_pages: Vec<clap_remote_controls_page>,
+    /// Rebuilt on the main thread after a state load and after each of the plugin's main-thread
+    /// tasks ([`Self::refresh_remote_controls`]), so the pages can follow what the plugin plays.
+    remote_control_pages: AtomicRefCell<Vec<clap_remote_controls_page>>,
+    host_remote_controls: AtomicRefCell<Option<ClapPtr<clap_host_remote_controls>>>,
 
     clap_plugin_render: clap_plugin_render,
 
@@ -397,7 +401,12 @@ impl<P: ClapPlugin> MainThreadExecutor<Task<P>> for Wrapper<P> {
     fn execute(&self, task: Task<P>, is_gui_thread: bool) {
         // This function is always called from the main thread, from [Self::on_main_thread].
         match task {
-            Task::PluginTask(task) => (self.task_executor.lock())(task),
+            Task::PluginTask(task) => {
+                (self.task_executor.lock())(task);
+                if is_gui_thread {
+                    self.refresh_remote_controls();
+                }
+            }
             #[cfg(feature = "editor")]
             Task::ParameterValueChanged(param_hash, normalized_value) => {
                 use nice_plug_core::editor::EditorHandle;
@@ -484,6 +493,39 @@ impl<P: ClapPlugin> MainThreadExecutor<Task<P>> for Wrapper<P> {
 }
 
 impl<P: ClapPlugin> Wrapper<P> {
+    /// Asks the plugin for its remote-control pages again and, when they differ from the ones
+    /// the host was given, keeps the new ones and tells the host
+    /// (`clap_host_remote_controls::changed`). Main thread only.
+    fn refresh_remote_controls(&self) {
+        let mut pages = Vec::new();
+        match self.plugin.try_lock() {
+            Some(plugin) => RemoteControlPages::define_remote_control_pages(
+                &*plugin,
+                &mut pages,
+                &self.param_ptr_to_hash,
+            ),
+            None => return,
+        }
+        let same = |a: &clap_remote_controls_page, b: &clap_remote_controls_page| {
+            a.section_name == b.section_name
+                && a.page_id == b.page_id
+                && a.page_name == b.page_name
+                && a.param_ids == b.param_ids
+                && a.is_for_preset == b.is_for_preset
+        };
+        {
+            let mut current = self.remote_control_pages.borrow_mut();
+            if current.len() == pages.len() && current.iter().zip(&pages).all(|(a, b)| same(a, b))
+            {
+                return;
+            }
+            *current = pages;
+        }
+        if let Some(host) = &*self.host_remote_controls.borrow() {
+            unsafe_clap_call! { host=>changed(&*self.host_callback) };
+        }
+    }
+
     /// # Safety
     ///
     /// `host_callback` needs to outlive the returned object.
@@ -715,7 +757,8 @@ impl<P: ClapPlugin> Wrapper<P> {
                 count: Some(Self::ext_remote_controls_count),
                 get: Some(Self::ext_remote_controls_get),
             },
-            remote_control_pages,
+            remote_control_pages: AtomicRefCell::new(remote_control_pages),
+            host_remote_controls: AtomicRefCell::new(None),
 
             clap_plugin_render: clap_plugin_render {
                 has_hard_realtime_requirement: Some(Self::ext_render_has_hard_realtime_requirement),
@@ -1697,6 +1740,11 @@ impl<P: ClapPlugin> Wrapper<P> {
                 query_host_extension::<clap_host_latency>(&wrapper.host_callback, CLAP_EXT_LATENCY);
             *wrapper.host_params.borrow_mut() =
                 query_host_extension::<clap_host_params>(&wrapper.host_callback, CLAP_EXT_PARAMS);
+            *wrapper.host_remote_controls.borrow_mut() =
+                query_host_extension::<clap_host_remote_controls>(
+                    &wrapper.host_callback,
+                    CLAP_EXT_REMOTE_CONTROLS,
+                );
             *wrapper.host_voice_info.borrow_mut() = query_host_extension::<clap_host_voice_info>(
                 &wrapper.host_callback,
                 CLAP_EXT_VOICE_INFO,
@@ -1805,6 +1853,12 @@ impl<P: ClapPlugin> Wrapper<P> {
 
         // NOTE: This needs to be dropped after the `plugin` lock to avoid deadlocks
         drop(activate_context);
+
+        // What the plugin plays can depend on the activation (a model prepared at the sample
+        // rate): its remote-control pages may follow.
+        if result {
+            wrapper.refresh_remote_controls();
+        }
 
         result
     }
@@ -3326,7 +3380,7 @@ impl<P: ClapPlugin> Wrapper<P> {
         check_null_ptr!(0, plugin, unsafe { (*plugin).plugin_data });
         let wrapper = unsafe { &*((*plugin).plugin_data as *const Self) };
 
-        wrapper.remote_control_pages.len() as u32
+        wrapper.remote_control_pages.borrow().len() as u32
     }
 
     unsafe extern "C" fn ext_remote_controls_get(
@@ -3337,8 +3391,9 @@ impl<P: ClapPlugin> Wrapper<P> {
         check_null_ptr!(false, plugin, unsafe { (*plugin).plugin_data }, page);
         let wrapper = unsafe { &*((*plugin).plugin_data as *const Self) };
 
-        crate::nice_debug_assert!(page_index as usize <= wrapper.remote_control_pages.len());
-        match wrapper.remote_control_pages.get(page_index as usize) {
+        let pages = wrapper.remote_control_pages.borrow();
+        crate::nice_debug_assert!((page_index as usize) < pages.len());
+        match pages.get(page_index as usize) {
             Some(p) => {
                 unsafe {
                     *page = *p;
@@ -3472,6 +3527,7 @@ impl<P: ClapPlugin> Wrapper<P> {
                 let success = wrapper.set_state_inner(&mut state);
                 if success {
                     crate::nice_trace!("Loaded state ({} bytes)", read_buffer.len());
+                    wrapper.refresh_remote_controls();
                 }
 
                 success
