@@ -543,9 +543,19 @@ fn preset_names() -> Vec<String> {
 }
 
 /// Presets with negative springs: Felt Piano writes its wire's bending stiffness as negative
-/// second-neighbour springs. The per-mass rule sums signed stiffnesses, so a negative spring
-/// lowers a mass's load and the rule's limit is no longer a bound from below.
-const NEGATIVE_SPRINGS: [&str; 1] = ["felt-piano.mdl"];
+/// second-neighbour springs, and so do the library's other stiff strings, bars, rings and
+/// plates (Bright Grand, Electric Tine, Tubular Bell, Glass Harmonica, Singing Bowl, Steel
+/// Pan). The per-mass rule sums signed stiffnesses, so a negative spring lowers a mass's load
+/// and the rule's limit is no longer a bound from below.
+const NEGATIVE_SPRINGS: [&str; 7] = [
+    "felt-piano.mdl",
+    "bright-grand.mdl",
+    "electric-tine.mdl",
+    "tubular-bell.mdl",
+    "glass-harmonica.mdl",
+    "singing-bowl.mdl",
+    "steel-pan.mdl",
+];
 
 /// On every preset the exact limit applies and, where every link is a positive spring, is at
 /// least the Gershgorin bound (a diagonally dominant 4M − K − 2Z is positive definite).

@@ -302,6 +302,9 @@ fn tuned_mode(template: &ressort_engine::Engine, gains: &Gains, expected_hz: f64
 /// point near the string's end, the presets' bows sound up to about ten cents off, sharp or
 /// flat with the bow's force (measured; the mode itself is tuned exactly).
 const BOWED_CENTS: f64 = 12.0;
+/// How far a bowed preset's `~pitch` may place its mode from the key so that the bowed
+/// sound is heard on it.
+const MODE_OFFSET_BOWED_CENTS: f64 = 20.0;
 
 #[test]
 fn pitched_presets_play_in_tune_at_three_keys_and_three_rates() {
@@ -320,6 +323,10 @@ fn pitched_presets_play_in_tune_at_three_keys_and_three_rates() {
                 .iter()
                 .any(|x| x.kind == ExciterKind::Bow);
             let heard_within = if bowed { BOWED_CENTS } else { 5.0 };
+            // A bow pulls its string flat by up to 16 cents with its force (Cello, Erhu): a
+            // bowed preset may place its mode sharp by `~pitch` so that what is heard is
+            // centred on the key.
+            let mode_within = if bowed { MODE_OFFSET_BOWED_CENTS } else { 5.0 };
             for key in keys_of(p.model()) {
                 let expected = 440.0 * 2f64.powf((key as f64 - 69.0) / 12.0);
                 let take = p.note(key, 0.8, 1.5);
@@ -331,7 +338,7 @@ fn pitched_presets_play_in_tune_at_three_keys_and_three_rates() {
                     "{name:<26} {sr:>6} Hz  key {key:>3}  mode {mode:+6.2} cents  heard \
                      {heard:+6.2} cents"
                 );
-                if mode.abs() > 5.0 || heard.abs() > heard_within {
+                if mode.abs() > mode_within || heard.abs() > heard_within {
                     wrong.push(format!(
                         "{name} at {sr} Hz, key {key}: mode {mode:+.1} cents, heard \
                          {heard:+.1} cents"
@@ -767,6 +774,53 @@ fn every_preset_plays_at_22_05_and_192_khz_without_a_guard_trip() {
                 ));
             }
         }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// The editor's Vary at its default amount, pressed three times from the preset as loaded
+/// (seeds 1, 2, 3): every press finds a variation, and each plays a C4 in the level band
+/// without a guard trip, rendered as the instrument plays it (not by Vary's own measure).
+#[test]
+fn vary_keeps_every_preset_playable_and_in_the_level_band() {
+    const SR: f64 = 48_000.0;
+    const AMOUNT: f64 = 0.5;
+    // Two Fingers String's variations are chaotic: Vary's own two-second measure and this
+    // render of the same controls differ by up to 6 dB, and some seeds find nothing playable
+    // (docs/NOTES.md). It is held to no trip and finite output only.
+    const UNPREDICTABLE: [&str; 1] = ["two-fingers-string"];
+    let mut wrong = Vec::new();
+    println!("preset                     seed 1 dBFS  seed 2 dBFS  seed 3 dBFS");
+    for (name, script) in presets() {
+        let loose = UNPREDICTABLE.contains(&name.as_str());
+        let mut p = Player::new(&script, SR);
+        let mut controls = Controls::DEFAULT;
+        let mut row = format!("{name:<26}");
+        for seed in 1..=3 {
+            let model = *p.model.take().expect("a model");
+            let (back, variation) = instrument::vary_playable(model, &controls, AMOUNT, seed);
+            p.model = Some(Box::new(back));
+            let Some(v) = variation else {
+                if !loose {
+                    wrong.push(format!("{name}, seed {seed}: no playable variation"));
+                }
+                continue;
+            };
+            controls = v.controls;
+            let take = p.play(controls, &[(0, Event::note_on(60, 0.8))], None, 2.0);
+            let finite = take.channels.iter().flatten().all(|v| v.is_finite());
+            let level = take.peak_db();
+            row += &format!(" {level:12.1}");
+            let in_band = loose || (BAND.0..=BAND.1).contains(&level);
+            if take.trips > 0 || !finite || !in_band {
+                wrong.push(format!(
+                    "{name}, seed {seed} ({controls:?}): {} trip(s), finite {finite}, \
+                     {level:.1} dBFS",
+                    take.trips
+                ));
+            }
+        }
+        println!("{row}");
     }
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }

@@ -77,6 +77,41 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("plucked-oscillator.mdl", None),
     ("bowed-oscillator.mdl", None),
     ("nonlinear-oscillator.mdl", None),
+    // The sound library (issue 37): Ressort's own designs; their headers give no counts.
+    ("hammered-dulcimer.mdl", None),
+    ("harp.mdl", None),
+    ("koto.mdl", None),
+    ("cello.mdl", None),
+    ("erhu.mdl", None),
+    ("glockenspiel.mdl", None),
+    ("marimba.mdl", None),
+    ("vibraphone.mdl", None),
+    ("xylophone.mdl", None),
+    ("bowed-plate.mdl", None),
+    ("crotales.mdl", None),
+    ("gong.mdl", None),
+    ("tubular-bell.mdl", None),
+    ("frame-drum.mdl", None),
+    ("snare.mdl", None),
+    ("steel-pan.mdl", None),
+    ("timpani.mdl", None),
+    ("tom.mdl", None),
+    ("bowed-pad.mdl", None),
+    ("glass-harmonica.mdl", None),
+    ("organ-pipes.mdl", None),
+    ("singing-bowl.mdl", None),
+    ("kick-resonator.mdl", None),
+    ("metal-sheet.mdl", None),
+    ("sympathetic-strings.mdl", None),
+    ("wood-box.mdl", None),
+    ("bright-grand.mdl", None),
+    ("electric-tine.mdl", None),
+    ("harpsichord.mdl", None),
+    ("toy-piano.mdl", None),
+    ("bouncing-ball.mdl", None),
+    ("duffing.mdl", None),
+    ("friction-squeal.mdl", None),
+    ("rattle.mdl", None),
 ];
 
 #[test]
@@ -330,7 +365,13 @@ fn every_preset_is_stable_and_sounds() {
             .inputs
             .iter()
             .any(|uses| matches!(uses.first(), Some(InputUse::Force(_))));
-        let bar = if struck {
+        // A force output (a velocity pickup: a damper read against a ground) gives a force
+        // per step, orders of magnitude below a position's excursion; the plugin's automatic
+        // trim levels it, and it must only be heard at all.
+        let force_pickup = matches!(info.outputs.first(), Some(OutputUse::Force(_)));
+        let bar = if force_pickup {
+            SILENCE
+        } else if struck {
             FIRST_OUTPUT_MOVES * FORCE_IMPULSE.abs()
         } else {
             FIRST_OUTPUT_MOVES_UNSTRUCK

@@ -46,6 +46,51 @@ pub const PRESETS: &[Preset] = presets![
     "two-fingers-string",
     "nofx-drone",
     "brokendown-string",
+    // The sound library (issue 37), by category.
+    // Strings / Struck
+    "hammered-dulcimer",
+    // Strings / Plucked
+    "harp",
+    "koto",
+    // Strings / Bowed
+    "cello",
+    "erhu",
+    // Mallets and Bars
+    "glockenspiel",
+    "marimba",
+    "vibraphone",
+    "xylophone",
+    // Bells and Plates
+    "bowed-plate",
+    "crotales",
+    "gong",
+    "tubular-bell",
+    // Membranes and Drums
+    "frame-drum",
+    "snare",
+    "steel-pan",
+    "timpani",
+    "tom",
+    // Drones and Pads
+    "bowed-pad",
+    "glass-harmonica",
+    "organ-pipes",
+    "singing-bowl",
+    // Resonators for a sidechain
+    "kick-resonator",
+    "metal-sheet",
+    "sympathetic-strings",
+    "wood-box",
+    // Polyphonic Keys
+    "bright-grand",
+    "electric-tine",
+    "harpsichord",
+    "toy-piano",
+    // Experimental
+    "bouncing-ball",
+    "duffing",
+    "friction-squeal",
+    "rattle",
 ];
 
 /// The model a new instance starts with.
