@@ -481,9 +481,8 @@ const UNBLOCKED_LIMIT: usize = 400;
 /// `aggressive_early_deflation`: a damped 8 × 8 membrane with an air cavity, 70 points, spun
 /// for ever in `schur_swap_22`). The unblocked QR has no such loop, but its price grows
 /// faster: a damped 138-mass string's `ressort modes` takes 0.12 s against 0.06 s, a 378-mass
-/// one 2.5 s against 0.9 s, and BrokenDown String's unit tables (401 points) 43 s against a few
-/// (release build, Nov 28), so larger matrices keep the multishift QR (docs/NOTES.md). None
-/// when the QR does not converge.
+/// one 2.5 s against 0.9 s (release build, Nov 28), so larger matrices keep the multishift QR
+/// (docs/NOTES.md). None when the QR does not converge.
 fn eigen_real(a: &Mat<f64>) -> Option<(Mat<c64>, faer::Col<c64>)> {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::linalg::evd::{self, ComputeEigenvectors, EvdParams};
