@@ -1,5 +1,5 @@
 //! The Presets tab: the sound library's browser. A category menu, a search over names and
-//! tags, favourites (★, kept per user), the factory and user presets side by side, previous and
+//! tags, favourites (*, kept per user), the factory and user presets side by side, previous and
 //! next buttons that load the neighbour in the shown list (the arrow keys do the same), and the
 //! chosen preset's notes. What is shown is decided by [`crate::library`]; loads go through
 //! [`EditorApp::submit`], in the background as every model change from the editor.
@@ -8,8 +8,8 @@ use super::*;
 use crate::library::{entries, neighbour, Entry};
 use crate::presets::{header_field, CATEGORIES, FIELDS};
 
-const STAR: &str = "★";
-const NO_STAR: &str = "☆";
+const STAR: &str = "*";
+const NO_STAR: &str = "·";
 
 impl EditorApp {
     /// Reads the user presets again and rebuilds the library (at open, after a save, on
@@ -88,7 +88,7 @@ impl EditorApp {
         let mut star = None;
         ui.label(
             RichText::new(format!(
-                "{} of {} presets · ↑↓ or ◀ ▶ load the neighbour · double-click loads",
+                "{} of {} presets · the arrow keys or < > load the neighbour · double-click loads",
                 shown.len(),
                 self.library.len()
             ))
@@ -156,7 +156,7 @@ impl EditorApp {
                 }
                 let fav = self.favourites.contains(&e.key);
                 if ui
-                    .small_button(if fav { "★ favourite" } else { "☆ add to favourites" })
+                    .small_button(if fav { "* favourite" } else { "add to favourites" })
                     .clicked()
                 {
                     self.toggle_favourite(&e.key);
@@ -178,15 +178,15 @@ impl EditorApp {
     fn browser_filters(&mut self, ui: &mut Ui) {
         ui.horizontal(|ui| {
             if ui
-                .button("◀")
-                .on_hover_text("Load the previous preset of the list (↑)")
+                .button("<")
+                .on_hover_text("Load the previous preset of the list (arrow up)")
                 .clicked()
             {
                 self.step_preset(-1);
             }
             if ui
-                .button("▶")
-                .on_hover_text("Load the next preset of the list (↓)")
+                .button(">")
+                .on_hover_text("Load the next preset of the list (arrow down)")
                 .clicked()
             {
                 self.step_preset(1);
@@ -199,7 +199,7 @@ impl EditorApp {
             if search.has_focus() && ui.input(|i| i.key_pressed(egui::Key::Escape)) {
                 self.filter.query.clear();
             }
-            if !self.filter.query.is_empty() && ui.small_button("✕").clicked() {
+            if !self.filter.query.is_empty() && ui.small_button("x").clicked() {
                 self.filter.query.clear();
             }
         });
