@@ -58,13 +58,11 @@ pub const PRESETS: &[Preset] = presets![
     // Mallets and Bars
     "glockenspiel",
     "marimba",
-    "vibraphone",
     "xylophone",
     // Bells and Plates
     "bowed-plate",
     "crotales",
     "gong",
-    "tubular-bell",
     // Membranes and Drums
     "frame-drum",
     "snare",
@@ -85,7 +83,6 @@ pub const PRESETS: &[Preset] = presets![
     "bright-grand",
     "electric-tine",
     "harpsichord",
-    "toy-piano",
     // Experimental
     "bouncing-ball",
     "duffing",
