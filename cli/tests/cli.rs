@@ -602,12 +602,11 @@ fn a_reader_that_stops_early_ends_the_command_quietly() {
     let out = child.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("panicked"), "{stderr}");
-    assert_eq!(out.status.signal(), Some(libc_sigpipe()), "{:?}", out.status);
+    assert_eq!(
+        out.status.signal(),
+        Some(libc_sigpipe()),
+        "{:?}",
+        out.status
+    );
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// SIGPIPE's number on the platforms Ressort builds for.
-#[cfg(unix)]
-fn libc_sigpipe() -> i32 {
-    13
 }

@@ -232,7 +232,8 @@ mod tests {
     use super::*;
 
     fn temp_dir(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("ressort-library-{name}-{}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("ressort-library-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir
@@ -246,7 +247,12 @@ mod tests {
         let none = Favourites::default();
         assert_eq!(lib.len(), PRESETS.len());
         for (i, e) in lib.iter().enumerate() {
-            assert!(!e.name.contains(':') && e.name != e.id, "{}: title {:?}", e.id, e.name);
+            assert!(
+                !e.name.contains(':') && e.name != e.id,
+                "{}: title {:?}",
+                e.id,
+                e.name
+            );
             let by_category = Filter {
                 category: e.category,
                 ..Filter::all()
@@ -269,7 +275,12 @@ mod tests {
         // Every category of the library holds presets, listed together in the browser's order.
         let ranks: Vec<usize> = lib
             .iter()
-            .map(|e| CATEGORIES.iter().position(|&c| Some(c) == e.category).unwrap())
+            .map(|e| {
+                CATEGORIES
+                    .iter()
+                    .position(|&c| Some(c) == e.category)
+                    .unwrap()
+            })
             .collect();
         assert!(ranks.windows(2).all(|w| w[0] <= w[1]), "{ranks:?}");
         for c in CATEGORIES {
@@ -286,7 +297,10 @@ mod tests {
         let lib = entries(&[]);
         let none = Favourites::default();
         let find = |f: Filter| -> Vec<String> {
-            f.apply(&lib, &none).iter().map(|&i| lib[i].id.clone()).collect()
+            f.apply(&lib, &none)
+                .iter()
+                .map(|&i| lib[i].id.clone())
+                .collect()
         };
         let bowed = find(Filter {
             query: "bow".into(),
@@ -299,9 +313,9 @@ mod tests {
             ..Filter::all()
         });
         assert!(!narrowed.is_empty() && narrowed.len() <= bowed.len());
-        assert!(narrowed
+        assert!(narrowed.iter().all(|id| lib
             .iter()
-            .all(|id| lib.iter().any(|e| &e.id == id && e.category == Some("Strings / Bowed"))));
+            .any(|e| &e.id == id && e.category == Some("Strings / Bowed"))));
         assert!(find(Filter {
             query: "no such word anywhere".into(),
             ..Filter::all()
@@ -383,7 +397,10 @@ mod tests {
 
     #[test]
     fn a_title_is_the_first_comment_line_unless_it_is_a_field() {
-        assert_eq!(title("# Felt Piano\n#\n# What: x\n").as_deref(), Some("Felt Piano"));
+        assert_eq!(
+            title("# Felt Piano\n#\n# What: x\n").as_deref(),
+            Some("Felt Piano")
+        );
         assert_eq!(title("# What: a model\n"), None);
         assert_eq!(title("@m mass 1 0 0\n"), None);
         assert_eq!(title("#\n# Felt\n"), None);

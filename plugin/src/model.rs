@@ -551,12 +551,17 @@ impl ModelStore {
         let state = self.running();
         let voices = self.voices();
         Some(
-            instrument::prepare_with(&state.name, &state.script, rate, state.playing.conventions())
-                .map(|mut p| {
-                    let declared = p.facts().settings.voices.unwrap_or(1) as usize;
-                    p.set_voices(if voices == 0 { declared } else { voices });
-                    p
-                }),
+            instrument::prepare_with(
+                &state.name,
+                &state.script,
+                rate,
+                state.playing.conventions(),
+            )
+            .map(|mut p| {
+                let declared = p.facts().settings.voices.unwrap_or(1) as usize;
+                p.set_voices(if voices == 0 { declared } else { voices });
+                p
+            }),
         )
     }
 

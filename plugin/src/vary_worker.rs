@@ -37,7 +37,12 @@ pub struct VaryJob {
 impl VaryJob {
     /// Starts a variation of `from` by `amount` from `seed` on a copy of `store`'s running
     /// model. None when the system cannot start a thread.
-    pub fn start(store: Arc<ModelStore>, from: Controls, amount: f64, seed: u64) -> Option<VaryJob> {
+    pub fn start(
+        store: Arc<ModelStore>,
+        from: Controls,
+        amount: f64,
+        seed: u64,
+    ) -> Option<VaryJob> {
         let (tx, rx) = crossbeam_channel::bounded(1);
         let thread = std::thread::Builder::new()
             .name("ressort-vary".into())
@@ -173,7 +178,9 @@ mod tests {
     #[test]
     fn an_inactive_plugin_says_why_it_cannot_vary() {
         let store = Arc::new(ModelStore::default());
-        let outcome = VaryJob::start(store, Controls::DEFAULT, 0.5, 1).unwrap().wait();
+        let outcome = VaryJob::start(store, Controls::DEFAULT, 0.5, 1)
+            .unwrap()
+            .wait();
         assert!(matches!(outcome, Outcome::Failed(_)), "{outcome:?}");
     }
 }

@@ -333,7 +333,10 @@ fn remote_control_pages_follow_the_running_model() {
             expect(&["Position Gain", "Velocity Curve", "", "", "", "", "", ""])
         )
     );
-    assert_eq!((mesh[2].0.as_str(), mesh[2].1.as_str()), ("Playing", "Playing"));
+    assert_eq!(
+        (mesh[2].0.as_str(), mesh[2].1.as_str()),
+        ("Playing", "Playing")
+    );
     assert_eq!(mesh[2].2[0], "A4");
     let changed = plugin.counters().remote_controls_changed;
 
@@ -361,7 +364,10 @@ fn remote_control_pages_follow_the_running_model() {
             "Tune"
         ])
     );
-    assert_eq!(piano[1].2[..3], expect(&["Force Gain", "Position Gain", "Velocity Curve"]));
+    assert_eq!(
+        piano[1].2[..3],
+        expect(&["Force Gain", "Position Gain", "Velocity Curve"])
+    );
     let told = plugin.counters().remote_controls_changed - changed;
     println!("clap_host_remote_controls.changed calls after the load: {told}");
     assert!(told >= 1, "the host was not told the pages changed");

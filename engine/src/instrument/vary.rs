@@ -204,8 +204,7 @@ mod tests {
     }
 
     #[test]
-    fn a_variation_stays_in_reach_moves_only_bound_slots_and_keeps_a_pitched_models_stiffness()
-    {
+    fn a_variation_stays_in_reach_moves_only_bound_slots_and_keeps_a_pitched_models_stiffness() {
         let mut c = Controls::DEFAULT;
         c.macros[5] = 0.9;
         c.tune_st = 3.0;

@@ -156,7 +156,11 @@ impl EditorApp {
                 }
                 let fav = self.favourites.contains(&e.key);
                 if ui
-                    .small_button(if fav { "* favourite" } else { "add to favourites" })
+                    .small_button(if fav {
+                        "* favourite"
+                    } else {
+                        "add to favourites"
+                    })
                     .clicked()
                 {
                     self.toggle_favourite(&e.key);

@@ -36,9 +36,15 @@ impl EditorApp {
         self.poll_vary();
         let busy = self.vary.job.is_some();
         ui.horizontal(|ui| {
-            ui.add_sized([74.0, 18.0], egui::Label::new(RichText::new("Vary").strong()));
+            ui.add_sized(
+                [74.0, 18.0],
+                egui::Label::new(RichText::new("Vary").strong()),
+            );
             if ui
-                .add_enabled(!busy, egui::Button::new(if busy { "varying…" } else { "Vary" }))
+                .add_enabled(
+                    !busy,
+                    egui::Button::new(if busy { "varying…" } else { "Vary" }),
+                )
                 .on_hover_text(
                     "Move the model's macros, Damping and Release (and Stiffness on unpitched \
                      models) by the amount, from the seed: every variation is played offline \

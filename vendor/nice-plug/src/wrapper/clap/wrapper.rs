@@ -515,8 +515,7 @@ impl<P: ClapPlugin> Wrapper<P> {
         };
         {
             let mut current = self.remote_control_pages.borrow_mut();
-            if current.len() == pages.len() && current.iter().zip(&pages).all(|(a, b)| same(a, b))
-            {
+            if current.len() == pages.len() && current.iter().zip(&pages).all(|(a, b)| same(a, b)) {
                 return;
             }
             *current = pages;
