@@ -38,10 +38,6 @@ fn every_preset_prepares_at_every_common_rate() {
     }
 }
 
-/// Presets with negative springs: Felt Piano writes its wire's bending stiffness as negative
-/// second-neighbour springs.
-const NEGATIVE_SPRINGS: [&str; 1] = ["felt-piano"];
-
 /// The clamp's limit: the exact stability limit of the linear network (issue 14) with the
 /// headroom, where it applies — never below the coupled (Gershgorin) bound it replaces (on
 /// networks of positive springs), and
@@ -67,8 +63,8 @@ fn the_stiffness_limit_matches_the_stability_analysis() {
                     preset.id
                 );
                 // The per-mass rule sums signed stiffnesses, so with negative springs (Felt
-                // Piano's bending) its figure is no bound and the exact limit is below it.
-                if !NEGATIVE_SPRINGS.contains(&preset.id) {
+                // Piano's or Steel Pan's bending) its figure is no bound from below.
+                if !exact.has_negative_links() {
                     assert!(
                         limit >= bound * (1.0 - 1e-9),
                         "{}: ×{limit} < bound ×{bound}",

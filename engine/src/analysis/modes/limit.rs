@@ -71,6 +71,9 @@ pub struct ExactStability {
     /// 2Z₁ (by the Damping gain) and 4M, each where that matrix has the entry.
     terms: Vec<Terms>,
     applies: bool,
+    /// True when some spring or damper of the network is negative (a stiff wire's or plate's
+    /// bending written as negative second-neighbour springs).
+    signed: bool,
     /// The symbolic factorisation of `pattern` (None where faer could not make one: every
     /// test then factorises from scratch).
     symbolic: Option<Arc<SymbolicCholesky<u32>>>,
@@ -117,6 +120,13 @@ impl ExactStability {
     /// then does not apply.
     pub fn applies(&self) -> bool {
         self.applies
+    }
+
+    /// True when some spring or damper of the network is negative. The per-mass (Gershgorin)
+    /// rule sums signed stiffnesses, so there a negative spring lowers a mass's load and the
+    /// rule's limit is no bound from below on the exact one.
+    pub fn has_negative_links(&self) -> bool {
+        self.signed
     }
 
     /// True when 4M − g·(K₁ + 2Z_K) − 2h·Z₁ is positive definite; None when the criterion
@@ -256,6 +266,7 @@ impl Engine {
             pattern,
             terms,
             applies: finite,
+            signed: !nonnegative,
             symbolic,
         };
         if finite && !nonnegative {
