@@ -41,6 +41,10 @@ pub const SHIPPED_RATES: [f64; 7] = [
 /// How many analysed models the process keeps in memory.
 pub const MEMORY_ENTRIES: usize = 32;
 
+/// The largest relative difference [`Analyses::distance`] lets pass as the same analysis run on
+/// another processor.
+pub const AGREEMENT: f64 = 1e-6;
+
 /// The analyses' results: every part of [`Facts`] that is not read off the script and its
 /// compiled engine.
 #[derive(Clone, Debug, PartialEq)]
@@ -74,6 +78,44 @@ impl Analyses {
             output_trim: f.output_trim,
             input_trim: f.input_trim,
         }
+    }
+
+    /// How far these analyses are from `other`: the largest relative difference of their
+    /// numbers, or what differs when their words or shapes do. The eigensolvers' floating-point
+    /// sums follow the processor's SIMD width (faer dispatches at run time), so the same
+    /// analysis on another machine differs in its last bits; a law or an analysis that
+    /// changed moves the numbers far more ([`AGREEMENT`]).
+    pub fn distance(&self, other: &Analyses) -> Result<f64, String> {
+        let text = |a: &Analyses| {
+            let mut t = Table::default();
+            t.push("compared", "", 48_000.0, a.clone());
+            t.to_text("")
+        };
+        let (a, b) = (text(self), text(other));
+        let mut worst = 0.0f64;
+        for (la, lb) in a.lines().zip(b.lines()) {
+            let (wa, wb): (Vec<&str>, Vec<&str>) = (
+                la.split_whitespace().collect(),
+                lb.split_whitespace().collect(),
+            );
+            if wa.len() != wb.len() {
+                return Err(format!("`{la}` against `{lb}`"));
+            }
+            for (x, y) in wa.iter().zip(&wb) {
+                match (x.parse::<f64>(), y.parse::<f64>()) {
+                    (Ok(x), Ok(y)) if x == y || (x.is_nan() && y.is_nan()) => {}
+                    (Ok(x), Ok(y)) => {
+                        worst = worst.max((x - y).abs() / x.abs().max(y.abs()));
+                    }
+                    _ if x == y => {}
+                    _ => return Err(format!("`{la}` against `{lb}`")),
+                }
+            }
+        }
+        if a.lines().count() != b.lines().count() {
+            return Err("a different number of lines".to_string());
+        }
+        Ok(worst)
     }
 
     /// Writes the results into facts made from the same script.

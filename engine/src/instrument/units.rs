@@ -75,13 +75,31 @@ impl UnitTable {
         0.5 * (lo + hi)
     }
 
-    fn is_monotone(&self) -> bool {
+    /// True when the reference mode follows the slot: monotone, and moving by more than
+    /// [`FLAT`] of itself over the range. A flatter table is a slot that does not move that
+    /// mode (a stiffness elsewhere in the model), whose "trend" is the eigensolver's rounding
+    /// and would flip with the processor's SIMD width; its unit is the plain value.
+    fn follows_the_slot(&self) -> bool {
         let p = &self.points;
-        let up = p.windows(2).all(|w| w[1].1 >= w[0].1);
-        let down = p.windows(2).all(|w| w[1].1 <= w[0].1);
-        (up || down) && p.iter().all(|x| x.1 > 0.0 && x.1.is_finite())
+        if !p.iter().all(|x| x.1 > 0.0 && x.1.is_finite()) {
+            return false;
+        }
+        let (lo, hi) = p.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
+            (lo.min(x.1), hi.max(x.1))
+        });
+        let noise = FLAT * hi;
+        if hi - lo <= noise {
+            return false;
+        }
+        let up = p.windows(2).all(|w| w[1].1 >= w[0].1 - noise);
+        let down = p.windows(2).all(|w| w[1].1 <= w[0].1 + noise);
+        up || down
     }
 }
+
+/// A unit table whose values span less than this fraction of themselves does not follow its
+/// slot ([`UnitTable::follows_the_slot`]).
+const FLAT: f64 = 1e-6;
 
 /// What moving a parameter changes, by the stability analysis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -184,7 +202,7 @@ pub fn unit_of(
             })
             .collect::<Option<Vec<_>>>()?;
         let t = UnitTable { points };
-        t.is_monotone().then_some(t)
+        t.follows_the_slot().then_some(t)
     };
     match role {
         Role::Mass if b.default > 0.0 => MacroUnit::MassRatio,
