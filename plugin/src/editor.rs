@@ -264,14 +264,9 @@ impl EditorApp {
     /// Runs a script: prepared in the background ([`ModelStore::submit_in_background`]) while
     /// the running model plays on; [`EditorApp::poll_loading`] reports how it went.
     fn submit(&mut self, name: String, script: String) {
-        // A model chosen in a legacy project is played as that project's were (its Output
-        // Gain was set for them); the editor's Update button moves the project on.
-        let playing = self.store.running().playing;
-        let ticket = self.store.submit_in_background(ModelState {
-            name: name.clone(),
-            script: script.clone(),
-            playing,
-        });
+        let ticket = self
+            .store
+            .choose_in_background(name.clone(), script.clone());
         self.message = Some((format!("loading {name}…"), ORANGE));
         self.loading = Some((ticket, name, script));
     }

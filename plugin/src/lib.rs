@@ -19,6 +19,7 @@ use std::num::NonZeroU32;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
+pub mod clap_presets;
 pub mod editor;
 pub mod files;
 #[cfg(target_os = "linux")]
@@ -650,6 +651,30 @@ impl ClapPlugin for Ressort {
     /// is played. Unbound slots do nothing and are on no page. The vendored CLAP wrapper asks
     /// again after a state load and after each main-thread task (the audio thread posts one
     /// when a new model starts) and tells the host when the pages changed (vendor/README.md).
+    /// The factory presets and the user folder, for the hosts' own browsers
+    /// ([`clap_presets`]).
+    const CLAP_PRESET_DISCOVERY: bool = true;
+
+    fn clap_preset_filetypes() -> Vec<PresetFiletype> {
+        clap_presets::filetypes()
+    }
+
+    fn clap_preset_locations() -> Vec<PresetLocation> {
+        clap_presets::locations()
+    }
+
+    fn clap_preset_metadata(
+        location: PresetLocationRef<'_>,
+    ) -> Result<Vec<PresetMetadata>, String> {
+        clap_presets::metadata(location)
+    }
+
+    fn clap_preset_loader(&self) -> Option<Box<dyn ClapPresetLoader>> {
+        Some(Box::new(clap_presets::Loader {
+            store: Arc::clone(&self.store),
+        }))
+    }
+
     fn remote_controls(&self, context: &mut impl RemoteControlsContext) {
         let p = &self.params;
         let (model, names) = self.store.macro_names();

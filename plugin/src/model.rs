@@ -466,6 +466,19 @@ impl ModelStore {
         ticket
     }
 
+    /// Plays a preset or script the user chose (the editor's browser, a host's preset load),
+    /// prepared in the background as [`ModelStore::submit_in_background`]. A model chosen in a
+    /// legacy project is played as that project's were (its Output Gain was set for them); the
+    /// editor's Update button moves the project on.
+    pub fn choose_in_background(self: &Arc<Self>, name: String, script: String) -> u64 {
+        let playing = self.running().playing;
+        self.submit_in_background(ModelState {
+            name,
+            script,
+            playing,
+        })
+    }
+
     /// Waits for every background submission to finish (the plugin's drop).
     pub fn finish_loads(&self) {
         let loads = std::mem::take(&mut *lock(&self.loads));

@@ -137,6 +137,9 @@ pub struct HostCounters {
 #[derive(Debug, Default)]
 pub struct HostMainThread {
     pub(crate) counters: Cell<HostCounters>,
+    /// What the plugin told the host after each preset load (`clap_host_preset_load`):
+    /// `Ok(load key or path)` for `loaded`, `Err(message)` for `on_error`.
+    pub(crate) preset_loads: std::cell::RefCell<Vec<Result<String, String>>>,
 }
 
 impl HostMainThread {
@@ -202,6 +205,37 @@ impl HostRemoteControlsImpl for HostMainThread {
     fn suggest_page(&self, _page_id: ClapId) {}
 }
 
+fn location_text(location: Location, load_key: Option<&std::ffi::CStr>) -> String {
+    let key = load_key.map(|k| k.to_string_lossy().into_owned());
+    match location {
+        Location::Plugin => format!("plugin:{}", key.unwrap_or_default()),
+        Location::File { path } => path.to_string_lossy().into_owned(),
+    }
+}
+
+impl HostPresetLoadImpl for HostMainThread {
+    fn on_error(
+        &self,
+        location: Location,
+        load_key: Option<&std::ffi::CStr>,
+        _os_error: i32,
+        message: Option<&std::ffi::CStr>,
+    ) {
+        let message = message.map(|m| m.to_string_lossy().into_owned());
+        self.preset_loads.borrow_mut().push(Err(format!(
+            "{}: {}",
+            location_text(location, load_key),
+            message.unwrap_or_default()
+        )));
+    }
+
+    fn loaded(&self, location: Location, load_key: Option<&std::ffi::CStr>) {
+        self.preset_loads
+            .borrow_mut()
+            .push(Ok(location_text(location, load_key)));
+    }
+}
+
 impl HostHandlers for TestHost {
     type Shared<'a> = HostShared;
     type MainThread<'a> = HostMainThread;
@@ -217,6 +251,7 @@ impl HostHandlers for TestHost {
             .register::<HostNotePorts>()
             .register::<HostThreadCheck>()
             .register::<HostRemoteControls>()
+            .register::<HostPresetLoad>()
             .register::<HostGui>();
     }
 }

@@ -42,6 +42,8 @@ use clack_extensions::params::{
     HostParams, HostParamsImplMainThread, HostParamsImplShared, ParamClearFlags, ParamInfoBuffer,
     ParamRescanFlags, PluginParams,
 };
+use clack_extensions::preset_discovery::prelude::{HostPresetLoad, Location, PluginPresetLoad};
+use clack_extensions::preset_discovery::HostPresetLoadImpl;
 use clack_extensions::remote_controls::{
     HostRemoteControls, HostRemoteControlsImpl, PluginRemoteControls, RemoteControlsPageBuffer,
 };
@@ -103,6 +105,7 @@ pub fn load_entry() -> PluginEntry {
     })
 }
 
+pub mod discovery;
 mod host;
 mod isolation;
 mod measure;

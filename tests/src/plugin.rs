@@ -13,6 +13,7 @@ pub(crate) struct Extensions {
     note_ports: Option<PluginNotePorts>,
     gui: Option<PluginGui>,
     remote_controls: Option<PluginRemoteControls>,
+    preset_load: Option<PluginPresetLoad>,
 }
 
 /// A CLAP remote-controls page as the host reads it.
@@ -107,6 +108,7 @@ impl TestPlugin {
             note_ports: shared.get_extension(),
             gui: shared.get_extension(),
             remote_controls: shared.get_extension(),
+            preset_load: shared.get_extension(),
         };
         let mut plugin = TestPlugin {
             processor: None,
@@ -657,6 +659,40 @@ impl TestPlugin {
                 })
             })
             .collect()
+    }
+
+    /// Loads a preset the host found by discovery (CLAP preset load): a factory preset by its
+    /// load key (`file` None), or a user preset's file. Returns what the plugin then told the
+    /// host: `loaded`, or `on_error` with its message.
+    pub fn load_preset(
+        &mut self,
+        file: Option<&Path>,
+        load_key: Option<&str>,
+    ) -> Result<String, String> {
+        let ext = self
+            .ext
+            .preset_load
+            .ok_or("the plugin has no preset-load extension")?;
+        let path =
+            file.map(|f| std::ffi::CString::new(f.to_string_lossy().as_bytes()).expect("path"));
+        let key = load_key.map(|k| std::ffi::CString::new(k).expect("load key"));
+        let location = match &path {
+            Some(p) => Location::File { path: p },
+            None => Location::Plugin,
+        };
+        let returned = {
+            let handle = self.instance.plugin_handle();
+            ext.load_from_location(&handle, location, key.as_deref())
+        };
+        let told = self
+            .instance
+            .access_handler(|h| h.preset_loads.borrow_mut().pop());
+        self.idle();
+        match (returned, told) {
+            (Ok(()), Some(Ok(what))) => Ok(what),
+            (Err(_), Some(Err(message))) => Err(message),
+            (r, t) => Err(format!("the plugin returned {r:?} but told the host {t:?}")),
+        }
     }
 
     /// The plugin's remote-control pages, in its order (none without the extension).

@@ -623,6 +623,43 @@ pub fn capture_standalone_after_clicks(
     result
 }
 
+/// The environment variable that hands a test's child process its private display.
+const DISPLAY_ENV: &str = "RESSORT_TEST_DISPLAY";
+
+/// Runs the calling test `test` in a child process (this test binary, `--exact`) that gets a
+/// private Xvfb of `width` × `height` in `DISPLAY`, so the X server outlives every X11
+/// connection the plugin opened (Xlib exits the process when its server goes away). In the
+/// child it returns the display; in the parent it runs the child, prints its output, asserts
+/// that it ran the test and passed, and returns None: the parent's test is then done.
+pub fn in_private_display(test: &str, width: u32, height: u32) -> Option<String> {
+    if let Ok(display) = std::env::var(DISPLAY_ENV) {
+        return Some(display);
+    }
+    let x = Xvfb::start(width, height)
+        .expect("Xvfb starts (scripts/setup.sh installs the xvfb package)");
+    let out = Command::new(std::env::current_exe().expect("the test binary"))
+        .args([test, "--exact", "--nocapture", "--test-threads=1"])
+        .env(DISPLAY_ENV, x.display())
+        .env("DISPLAY", x.display())
+        .output()
+        .expect("run the test in a child process");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    print!("{stdout}");
+    eprint!("{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{test} failed in its child process: {}",
+        out.status
+    );
+    // The child ran this very test: a renamed test would otherwise match nothing and pass.
+    assert!(
+        stdout.contains(&format!("test {test} ... "))
+            && stdout.contains("test result: ok. 1 passed"),
+        "the child process did not run `{test}`"
+    );
+    None
+}
+
 /// A plain top-level window to embed an editor in, as a DAW's plugin window is. Kept open
 /// while the value lives.
 #[derive(Debug)]

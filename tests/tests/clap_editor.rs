@@ -8,12 +8,10 @@
 //! outlives every X11 connection the plugin opened (Xlib exits the process when its server
 //! goes away).
 
-use ressort_tests::screen::{capture, plot_stats, shows_motion, HostWindow, Xvfb};
+use ressort_tests::screen::{capture, in_private_display, plot_stats, shows_motion, HostWindow};
 use ressort_tests::{state, struck_default, thread_count, Score};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
-
-const DISPLAY_ENV: &str = "RESSORT_TEST_DISPLAY";
 
 /// An oscillator with a negative stiffness, displaced at rest: it runs away and its guard trips
 /// at once (no clamp can hold a negative stiffness).
@@ -26,29 +24,7 @@ const EXPLODING: &str = "\
 #[test]
 fn the_editor_opens_in_a_clap_host_and_shows_sidechain_strikes() {
     let name = "the_editor_opens_in_a_clap_host_and_shows_sidechain_strikes";
-    let Ok(display) = std::env::var(DISPLAY_ENV) else {
-        let x = Xvfb::start(1280, 800)
-            .expect("Xvfb starts (scripts/setup.sh installs the xvfb package)");
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([name, "--exact", "--nocapture", "--test-threads=1"])
-            .env(DISPLAY_ENV, x.display())
-            .env("DISPLAY", x.display())
-            .output()
-            .expect("run the test in a child process");
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        print!("{stdout}");
-        eprint!("{}", String::from_utf8_lossy(&out.stderr));
-        assert!(
-            out.status.success(),
-            "the editor test failed: {}",
-            out.status
-        );
-        // The child ran this very test: a renamed test would otherwise match nothing and pass.
-        assert!(
-            stdout.contains(&format!("test {name} ... "))
-                && stdout.contains("test result: ok. 1 passed"),
-            "the child process did not run `{name}`"
-        );
+    let Some(display) = in_private_display(name, 1280, 800) else {
         return;
     };
     let host = HostWindow::open(&display, "Test DAW", 1100, 700).expect("host window");

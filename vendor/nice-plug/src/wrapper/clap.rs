@@ -4,15 +4,25 @@ mod util;
 mod context;
 mod descriptor;
 pub mod features;
+pub mod presets;
 mod wrapper;
 
 use crate::wrapper::clap::features::ClapFeature;
 
 /// Re-export for the macro
 pub use self::descriptor::PluginDescriptor;
+pub use self::presets::{
+    ClapPresetLoader, PresetFiletype, PresetFlags, PresetLocation, PresetLocationKind,
+    PresetLocationRef, PresetMetadata, PresetProviderEntry,
+};
 pub use self::wrapper::Wrapper;
 pub use clap_sys::entry::clap_plugin_entry;
 pub use clap_sys::factory::plugin_factory::{CLAP_PLUGIN_FACTORY_ID, clap_plugin_factory};
+pub use clap_sys::factory::preset_discovery::{
+    CLAP_PRESET_DISCOVERY_FACTORY_ID, CLAP_PRESET_DISCOVERY_FACTORY_ID_COMPAT,
+    clap_preset_discovery_factory, clap_preset_discovery_indexer, clap_preset_discovery_provider,
+    clap_preset_discovery_provider_descriptor,
+};
 pub use clap_sys::host::clap_host;
 pub use clap_sys::plugin::{clap_plugin, clap_plugin_descriptor};
 pub use clap_sys::version::CLAP_VERSION;
@@ -43,6 +53,35 @@ pub trait ClapPlugin: Plugin {
     /// that the host can use to provide better hardware mapping for a plugin. See the linked
     /// extension for more information.
     fn remote_controls(&self, context: &mut impl RemoteControlsContext) {}
+
+    /// Whether the CLAP preset-discovery factory offers a provider for this plugin (patch 9,
+    /// vendor/README.md). The provider declares [`Self::clap_preset_filetypes`] and
+    /// [`Self::clap_preset_locations`], and answers with [`Self::clap_preset_metadata`]; none of
+    /// them has an instance to ask, as a host indexes presets without making one.
+    const CLAP_PRESET_DISCOVERY: bool = false;
+
+    /// The file types of the plugin's preset files.
+    fn clap_preset_filetypes() -> Vec<PresetFiletype> {
+        Vec::new()
+    }
+
+    /// Where the plugin's presets are: inside the plugin, in folders.
+    fn clap_preset_locations() -> Vec<PresetLocation> {
+        Vec::new()
+    }
+
+    /// The presets at one location (for a file, the one it holds).
+    fn clap_preset_metadata(
+        location: PresetLocationRef<'_>,
+    ) -> Result<Vec<PresetMetadata>, String> {
+        Err(format!("no presets at {location:?}"))
+    }
+
+    /// What loads presets for the CLAP preset-load extension, asked once when the plugin is
+    /// made; None leaves the extension out.
+    fn clap_preset_loader(&self) -> Option<Box<dyn ClapPresetLoader>> {
+        None
+    }
 }
 
 /// Configuration for the plugin's polyphonic modulation options, if it supports .
@@ -70,6 +109,11 @@ macro_rules! nice_export_clap {
             use $crate::wrapper::setup_logger;
             use $crate::wrapper::clap::{PluginDescriptor, Wrapper};
             use $crate::wrapper::clap::{CLAP_PLUGIN_FACTORY_ID, clap_host, clap_plugin, clap_plugin_descriptor, clap_plugin_factory};
+            use $crate::wrapper::clap::{
+                CLAP_PRESET_DISCOVERY_FACTORY_ID, CLAP_PRESET_DISCOVERY_FACTORY_ID_COMPAT,
+                PresetProviderEntry, clap_preset_discovery_factory, clap_preset_discovery_indexer,
+                clap_preset_discovery_provider, clap_preset_discovery_provider_descriptor,
+            };
             use ::std::collections::HashSet;
             use ::std::ffi::{CStr, c_void};
             use ::std::os::raw::c_char;
@@ -155,6 +199,56 @@ macro_rules! nice_export_clap {
                 ::std::ptr::null()
             }
 
+            const CLAP_PRESET_DISCOVERY_FACTORY: clap_preset_discovery_factory =
+                clap_preset_discovery_factory {
+                    count: Some(preset_provider_count),
+                    get_descriptor: Some(get_preset_provider_descriptor),
+                    create: Some(create_preset_provider),
+                };
+
+            // One preset provider per plugin type that declares presets.
+            static PRESET_PROVIDERS: OnceLock<Vec<PresetProviderEntry>> = OnceLock::new();
+
+            fn preset_providers() -> &'static [PresetProviderEntry] {
+                PRESET_PROVIDERS.get_or_init(|| {
+                    [$(PresetProviderEntry::for_plugin::<$plugin_ty>()),+]
+                        .into_iter()
+                        .flatten()
+                        .collect()
+                })
+            }
+
+            unsafe extern "C" fn preset_provider_count(
+                _factory: *const clap_preset_discovery_factory,
+            ) -> u32 {
+                preset_providers().len() as u32
+            }
+
+            unsafe extern "C" fn get_preset_provider_descriptor(
+                _factory: *const clap_preset_discovery_factory,
+                index: u32,
+            ) -> *const clap_preset_discovery_provider_descriptor {
+                match preset_providers().get(index as usize) {
+                    Some(entry) => entry.descriptor(),
+                    None => ::std::ptr::null(),
+                }
+            }
+
+            unsafe extern "C" fn create_preset_provider(
+                _factory: *const clap_preset_discovery_factory,
+                indexer: *const clap_preset_discovery_indexer,
+                provider_id: *const c_char,
+            ) -> *const clap_preset_discovery_provider {
+                if provider_id.is_null() {
+                    return ::std::ptr::null();
+                }
+                let id = unsafe { CStr::from_ptr(provider_id) };
+                match preset_providers().iter().find(|e| e.is(id)) {
+                    Some(entry) => unsafe { entry.create(indexer) },
+                    None => ::std::ptr::null(),
+                }
+            }
+
             pub extern "C" fn init(_plugin_path: *const c_char) -> bool {
                 $({setup_logger::<$plugin_ty>();})+
                 true
@@ -163,8 +257,17 @@ macro_rules! nice_export_clap {
             pub extern "C" fn deinit() {}
 
             pub extern "C" fn get_factory(factory_id: *const c_char) -> *const c_void {
-                if !factory_id.is_null() && unsafe { CStr::from_ptr(factory_id) } == CLAP_PLUGIN_FACTORY_ID {
+                if factory_id.is_null() {
+                    return ::std::ptr::null();
+                }
+                let id = unsafe { CStr::from_ptr(factory_id) };
+                if id == CLAP_PLUGIN_FACTORY_ID {
                     &CLAP_PLUGIN_FACTORY as *const _ as *const c_void
+                } else if (id == CLAP_PRESET_DISCOVERY_FACTORY_ID
+                    || id == CLAP_PRESET_DISCOVERY_FACTORY_ID_COMPAT)
+                    && !preset_providers().is_empty()
+                {
+                    &CLAP_PRESET_DISCOVERY_FACTORY as *const _ as *const c_void
                 } else {
                     ::std::ptr::null()
                 }

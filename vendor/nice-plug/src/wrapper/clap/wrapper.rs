@@ -34,6 +34,10 @@ use clap_sys::ext::params::{
     CLAP_PARAM_IS_STEPPED, CLAP_PARAM_RESCAN_VALUES, clap_host_params, clap_param_info,
     clap_plugin_params,
 };
+use clap_sys::ext::preset_load::{
+    CLAP_EXT_PRESET_LOAD, CLAP_EXT_PRESET_LOAD_COMPAT, clap_host_preset_load,
+    clap_plugin_preset_load,
+};
 use clap_sys::ext::remote_controls::{
     CLAP_EXT_REMOTE_CONTROLS, clap_host_remote_controls, clap_plugin_remote_controls,
     clap_remote_controls_page,
@@ -55,6 +59,7 @@ use clap_sys::ext::voice_info::{
     CLAP_EXT_VOICE_INFO, CLAP_VOICE_INFO_SUPPORTS_OVERLAPPING_NOTES, clap_host_voice_info,
     clap_plugin_voice_info, clap_voice_info,
 };
+use clap_sys::factory::preset_discovery::clap_preset_discovery_location_kind;
 use clap_sys::fixedpoint::{CLAP_BEATTIME_FACTOR, CLAP_SECTIME_FACTOR};
 use clap_sys::host::clap_host;
 use clap_sys::id::{CLAP_INVALID_ID, clap_id};
@@ -103,6 +108,7 @@ use crate::wrapper::clap::ClapPlugin;
 use crate::wrapper::clap::context::RemoteControlPages;
 #[cfg(feature = "editor")]
 use crate::wrapper::clap::context::WrapperGuiContext;
+use crate::wrapper::clap::presets::{self, ClapPresetLoader};
 use crate::wrapper::clap::util::{read_stream, write_stream};
 use crate::wrapper::state::{self};
 use crate::wrapper::util::buffer_management::{BufferManager, ChannelPointers};
@@ -258,6 +264,11 @@ pub struct Wrapper<P: ClapPlugin> {
     /// tasks ([`Self::refresh_remote_controls`]), so the pages can follow what the plugin plays.
     remote_control_pages: AtomicRefCell<Vec<clap_remote_controls_page>>,
     host_remote_controls: AtomicRefCell<Option<ClapPtr<clap_host_remote_controls>>>,
+
+    /// Preset load (patch 9): what the plugin gave to load presets with, if anything.
+    preset_loader: Option<Box<dyn ClapPresetLoader>>,
+    clap_plugin_preset_load: clap_plugin_preset_load,
+    host_preset_load: AtomicRefCell<Option<ClapPtr<clap_host_preset_load>>>,
 
     clap_plugin_render: clap_plugin_render,
 
@@ -625,6 +636,8 @@ impl<P: ClapPlugin> Wrapper<P> {
             }
         }
 
+        let preset_loader = plugin.clap_preset_loader();
+
         // Support for the remote controls extension
         let mut remote_control_pages = Vec::new();
         RemoteControlPages::define_remote_control_pages(
@@ -758,6 +771,12 @@ impl<P: ClapPlugin> Wrapper<P> {
             },
             remote_control_pages: AtomicRefCell::new(remote_control_pages),
             host_remote_controls: AtomicRefCell::new(None),
+
+            preset_loader,
+            clap_plugin_preset_load: clap_plugin_preset_load {
+                from_location: Some(Self::ext_preset_load_from_location),
+            },
+            host_preset_load: AtomicRefCell::new(None),
 
             clap_plugin_render: clap_plugin_render {
                 has_hard_realtime_requirement: Some(Self::ext_render_has_hard_realtime_requirement),
@@ -1744,6 +1763,16 @@ impl<P: ClapPlugin> Wrapper<P> {
                     &wrapper.host_callback,
                     CLAP_EXT_REMOTE_CONTROLS,
                 );
+            *wrapper.host_preset_load.borrow_mut() = query_host_extension::<clap_host_preset_load>(
+                &wrapper.host_callback,
+                CLAP_EXT_PRESET_LOAD,
+            )
+            .or_else(|| {
+                query_host_extension::<clap_host_preset_load>(
+                    &wrapper.host_callback,
+                    CLAP_EXT_PRESET_LOAD_COMPAT,
+                )
+            });
             *wrapper.host_voice_info.borrow_mut() = query_host_extension::<clap_host_voice_info>(
                 &wrapper.host_callback,
                 CLAP_EXT_VOICE_INFO,
@@ -2395,6 +2424,12 @@ impl<P: ClapPlugin> Wrapper<P> {
             }
         } else if id == CLAP_EXT_REMOTE_CONTROLS {
             &wrapper.clap_plugin_remote_controls as *const _ as *const c_void
+        } else if id == CLAP_EXT_PRESET_LOAD || id == CLAP_EXT_PRESET_LOAD_COMPAT {
+            if wrapper.preset_loader.is_some() {
+                &wrapper.clap_plugin_preset_load as *const _ as *const c_void
+            } else {
+                std::ptr::null()
+            }
         } else if id == CLAP_EXT_RENDER {
             &wrapper.clap_plugin_render as *const _ as *const c_void
         } else if id == CLAP_EXT_STATE {
@@ -3401,6 +3436,38 @@ impl<P: ClapPlugin> Wrapper<P> {
             }
             None => false,
         }
+    }
+
+    /// Preset load (patch 9): hands the host's location and load key to the plugin's loader,
+    /// then tells the host `loaded`, or `on_error` with the loader's message.
+    unsafe extern "C" fn ext_preset_load_from_location(
+        plugin: *const clap_plugin,
+        location_kind: clap_preset_discovery_location_kind,
+        location: *const c_char,
+        load_key: *const c_char,
+    ) -> bool {
+        check_null_ptr!(false, plugin, unsafe { (*plugin).plugin_data });
+        let wrapper = unsafe { &*((*plugin).plugin_data as *const Self) };
+        let Some(loader) = &wrapper.preset_loader else {
+            return false;
+        };
+        let result = match unsafe { presets::location_from_raw(location_kind, location) } {
+            Some(at) => loader.load(at, unsafe { presets::optional_str(load_key) }),
+            None => Err(String::from("unknown preset location")),
+        };
+        if let Some(host) = &*wrapper.host_preset_load.borrow() {
+            match &result {
+                Ok(()) => {
+                    unsafe_clap_call! { host=>loaded(&*wrapper.host_callback, location_kind, location, load_key) };
+                }
+                Err(message) => {
+                    let message =
+                        std::ffi::CString::new(message.replace('\0', "")).unwrap_or_default();
+                    unsafe_clap_call! { host=>on_error(&*wrapper.host_callback, location_kind, location, load_key, 0, message.as_ptr()) };
+                }
+            }
+        }
+        result.is_ok()
     }
 
     unsafe extern "C" fn ext_render_has_hard_realtime_requirement(
