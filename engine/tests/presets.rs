@@ -109,6 +109,17 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("duffing.mdl", None),
     ("friction-squeal.mdl", None),
     ("rattle.mdl", None),
+    ("bolted-piano-string.mdl", None),
+    ("tangent-clavinet.mdl", None),
+    ("jawari-sitar.mdl", None),
+    ("open-back-banjo.mdl", None),
+    ("kalimba-tine.mdl", None),
+    ("slit-drum.mdl", None),
+    ("chime-tube.mdl", None),
+    ("musical-saw.mdl", None),
+    ("talking-drum.mdl", None),
+    ("aeolian-harp.mdl", None),
+    ("celesta.mdl", None),
 ];
 
 #[test]

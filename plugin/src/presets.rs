@@ -49,9 +49,13 @@ pub const PRESETS: &[Preset] = presets![
     // The sound library (issue 37), by category.
     // Strings / Struck
     "hammered-dulcimer",
+    "bolted-piano-string",
+    "tangent-clavinet",
     // Strings / Plucked
     "harp",
     "koto",
+    "jawari-sitar",
+    "open-back-banjo",
     // Strings / Bowed
     "cello",
     "erhu",
@@ -59,21 +63,27 @@ pub const PRESETS: &[Preset] = presets![
     "glockenspiel",
     "marimba",
     "xylophone",
+    "kalimba-tine",
+    "slit-drum",
     // Bells and Plates
     "bowed-plate",
     "crotales",
     "gong",
+    "chime-tube",
+    "musical-saw",
     // Membranes and Drums
     "frame-drum",
     "snare",
     "steel-pan",
     "timpani",
     "tom",
+    "talking-drum",
     // Drones and Pads
     "bowed-pad",
     "glass-harmonica",
     "organ-pipes",
     "singing-bowl",
+    "aeolian-harp",
     // Resonators for a sidechain
     "kick-resonator",
     "metal-sheet",
@@ -83,6 +93,7 @@ pub const PRESETS: &[Preset] = presets![
     "bright-grand",
     "electric-tine",
     "harpsichord",
+    "celesta",
     // Experimental
     "bouncing-ball",
     "duffing",
