@@ -20,4 +20,13 @@ fi
 cargo build --release --locked -q --manifest-path "$source_dir/Cargo.toml" \
   --target-dir target/clap-validator
 # --only-failed keeps the log to the failures and the summary line.
-target/clap-validator/release/clap-validator validate "$bundle" --only-failed "$@"
+#
+# Two tests are left out: preset-discovery-crawl and preset-discovery-load hang in the validator
+# itself on any plugin whose presets live inside it. Its metadata receiver's `begin_preset`
+# holds the lock of its result while it calls `flush_preset`, which takes the same lock again
+# when a second preset with a load key begins (src/plugin/preset_discovery/metadata_receiver.rs
+# in this copy and upstream at b2f1d9b): a self-deadlock, then "Timed out after 45 seconds".
+# Ressort's factory presets are such a container. tests/tests/host_presets.rs crawls every
+# declared location and loads presets in the CLAP test host instead (docs/NOTES.md).
+target/clap-validator/release/clap-validator validate "$bundle" --only-failed \
+  -x '^preset-discovery-crawl$' -x '^preset-discovery-load$' "$@"

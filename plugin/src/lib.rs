@@ -34,6 +34,7 @@ pub mod param_text;
 pub mod params;
 pub mod plot;
 pub mod presets;
+pub mod remote_pages;
 pub mod report;
 pub mod runtime;
 pub mod state;
@@ -142,6 +143,15 @@ impl Default for Ressort {
 }
 
 impl Ressort {
+    /// What the CLAP remote-control pages are made from: shared with the wrapper, which asks
+    /// again without locking the plugin.
+    fn remote_pages(&self) -> remote_pages::RemotePages {
+        remote_pages::RemotePages {
+            params: Arc::clone(&self.params),
+            store: Arc::clone(&self.store),
+        }
+    }
+
     /// The model store shared with the editor.
     pub fn store(&self) -> &Arc<ModelStore> {
         &self.store
@@ -643,14 +653,6 @@ impl ClapPlugin for Ressort {
         ClapFeature::Stereo,
     ];
 
-    /// The pages a hardware controller or a host's device panel shows (CLAP remote controls),
-    /// for the running model: first a page named after it with its bound macro slots (whose
-    /// value text names their `param`s) and, where fewer than eight are bound, the physics
-    /// (Stiffness, Damping, Release, Output Gain, Tune, Force Gain, Position Gain, Velocity
-    /// Curve); then the physics that did not fit, the bound slots beyond the eighth, and how it
-    /// is played. Unbound slots do nothing and are on no page. The vendored CLAP wrapper asks
-    /// again after a state load and after each main-thread task (the audio thread posts one
-    /// when a new model starts) and tells the host when the pages changed (vendor/README.md).
     /// The factory presets and the user folder, for the hosts' own browsers
     /// ([`clap_presets`]).
     const CLAP_PRESET_DISCOVERY: bool = true;
@@ -675,72 +677,13 @@ impl ClapPlugin for Ressort {
         }))
     }
 
+    /// The running model's pages ([`remote_pages`]).
     fn remote_controls(&self, context: &mut impl RemoteControlsContext) {
-        let p = &self.params;
-        let (model, names) = self.store.macro_names();
-        let bound: Vec<usize> = (0..model::NUM_MACROS)
-            .filter(|&i| names.get(i).is_some_and(|n| n.is_some()))
-            .collect();
-        let physics: [&FloatParam; 8] = [
-            &p.stiffness,
-            &p.damping,
-            &p.release,
-            &p.output_gain,
-            &p.tune,
-            &p.force_gain,
-            &p.position_gain,
-            &p.velocity_curve,
-        ];
-        let first = bound.len().min(8);
-        let fill = 8 - first;
-        let title: String = if bound.is_empty() {
-            model.clone()
-        } else {
-            let list: Vec<&str> = bound[..first]
-                .iter()
-                .filter_map(|&i| names[i].as_deref())
-                .collect();
-            format!("{model}: {}", list.join(", "))
-        };
-        context.add_section("Model", |section| {
-            section.add_page(title.as_str(), |page| {
-                for &i in &bound[..first] {
-                    page.add_param(&p.macros[i].value);
-                }
-                for param in &physics[..fill] {
-                    page.add_param(*param);
-                }
-            });
-        });
-        if fill < physics.len() {
-            context.add_section("Instrument", |section| {
-                section.add_page("Physics", |page| {
-                    for param in &physics[fill..] {
-                        page.add_param(*param);
-                    }
-                });
-            });
-        }
-        if bound.len() > 8 {
-            context.add_section("Model", |section| {
-                section.add_page("More macros", |page| {
-                    for &i in &bound[8..] {
-                        page.add_param(&p.macros[i].value);
-                    }
-                });
-            });
-        }
-        context.add_section("Playing", |section| {
-            section.add_page("Playing", |page| {
-                page.add_param(&p.a4);
-                page.add_param(&p.bend_range);
-                page.add_param(&p.mpe);
-                page.add_param(&p.voices);
-                page.add_param(&p.trigger);
-                page.add_param(&p.trigger_sensitivity);
-                page.add_param(&p.dc_filter);
-            });
-        });
+        self.remote_pages().define(context);
+    }
+
+    fn clap_remote_controls(&self) -> Option<Arc<dyn ClapRemoteControls>> {
+        Some(Arc::new(self.remote_pages()))
     }
 }
 

@@ -222,6 +222,41 @@ fn a_preset_the_plugin_cannot_load_is_reported_and_the_model_plays_on() {
     assert!(phrase(&mut plugin).peak() > 1e-3, "the user preset sounds");
 }
 
+/// What clap-validator's preset-discovery-load does (scripts/clap-validator.sh says why it is
+/// left out there): every preset the index lists, loaded in turn into one instance through
+/// preset load, processed after each; each one becomes the running model and a note on it
+/// stays finite.
+#[test]
+fn every_listed_preset_loads_through_preset_load() {
+    user_folder();
+    let index = discovery::index();
+    let mut plugin = TestPlugin::new();
+    plugin.activate(48_000.0, 1, 512);
+    let mut loaded = 0;
+    for preset in &index.presets {
+        let file = preset.file.as_deref();
+        let result = plugin.load_preset(file, preset.load_key.as_deref());
+        if file.is_some_and(|f| f.ends_with("Broken.mdl")) {
+            assert!(result.is_err(), "the broken script is refused");
+            continue;
+        }
+        result.unwrap_or_else(|e| panic!("{}: {e}", preset.name));
+        let id = match (file, &preset.load_key) {
+            (Some(f), _) => f.file_stem().unwrap().to_string_lossy().into_owned(),
+            (None, Some(key)) => key.clone(),
+            (None, None) => panic!("{}: a factory preset without a load key", preset.name),
+        };
+        wait_for_model(&mut plugin, &id);
+        let out = plugin
+            .render(0.1, 480, &Score::new().note_on(0, 60, 0.8))
+            .audio;
+        assert!(out.is_finite(), "{id}");
+        loaded += 1;
+    }
+    println!("{loaded} presets loaded through preset load, one instance, processed after each");
+    assert_eq!(loaded, index.presets.len() - 1);
+}
+
 /// Where the editor's browser is in a 1100 × 700 editor (window pixels): the search field and
 /// the `>` button of the Presets tab's filter row.
 const SEARCH: (i16, i16) = (145, 98);

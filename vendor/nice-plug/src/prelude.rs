@@ -40,7 +40,9 @@ pub use crate::plugin::{Plugin, ProcessStatus, TaskExecutor};
 #[cfg(feature = "editor")]
 pub use crate::plugin::{TrackColor, TrackInfo};
 pub use crate::wrapper::clap::features::ClapFeature;
-pub use crate::wrapper::clap::{ClapPlugin, PolyModulationConfig};
+pub use crate::wrapper::clap::{
+    ClapPlugin, ClapRemoteControls, PolyModulationConfig, RemoteControlPages,
+};
 pub use crate::wrapper::clap::{
     ClapPresetLoader, PresetFiletype, PresetFlags, PresetLocation, PresetLocationKind,
     PresetLocationRef, PresetMetadata,

@@ -10,6 +10,7 @@ mod wrapper;
 use crate::wrapper::clap::features::ClapFeature;
 
 /// Re-export for the macro
+pub use self::context::RemoteControlPages;
 pub use self::descriptor::PluginDescriptor;
 pub use self::presets::{
     ClapPresetLoader, PresetFiletype, PresetFlags, PresetLocation, PresetLocationKind,
@@ -54,6 +55,15 @@ pub trait ClapPlugin: Plugin {
     /// extension for more information.
     fn remote_controls(&self, context: &mut impl RemoteControlsContext) {}
 
+    /// Where the wrapper asks for the remote-control pages again when they may have changed
+    /// (patch 8, vendor/README.md), without locking the plugin: the audio thread holds that
+    /// lock while it processes, and a main thread that took it then made `process()` fail.
+    /// Asked once when the plugin is made; None keeps the pages [`Self::remote_controls`] gave
+    /// then, refreshed only while the plugin is not processing.
+    fn clap_remote_controls(&self) -> Option<std::sync::Arc<dyn ClapRemoteControls>> {
+        None
+    }
+
     /// Whether the CLAP preset-discovery factory offers a provider for this plugin (patch 9,
     /// vendor/README.md). The provider declares [`Self::clap_preset_filetypes`] and
     /// [`Self::clap_preset_locations`], and answers with [`Self::clap_preset_metadata`]; none of
@@ -82,6 +92,12 @@ pub trait ClapPlugin: Plugin {
     fn clap_preset_loader(&self) -> Option<Box<dyn ClapPresetLoader>> {
         None
     }
+}
+
+/// Defines the remote-control pages from state the plugin shares with it (patch 10,
+/// vendor/README.md): see [`ClapPlugin::clap_remote_controls`].
+pub trait ClapRemoteControls: Send + Sync {
+    fn pages(&self, context: &mut RemoteControlPages<'_>);
 }
 
 /// Configuration for the plugin's polyphonic modulation options, if it supports .

@@ -70,7 +70,9 @@ pub(crate) struct WrapperGuiContext<P: ClapPlugin> {
 /// A [`RemoteControlsContext`] implementation for the wrapper. This is used during initialization
 /// to allow the plugin to declare remote control pages. This struct defines the pages in the
 /// correct format.
-pub(crate) struct RemoteControlPages<'a> {
+/// The remote-control pages being defined: what [`crate::wrapper::clap::ClapRemoteControls`]
+/// writes to (it implements [`RemoteControlsContext`]).
+pub struct RemoteControlPages<'a> {
     param_ptr_to_hash: &'a HashMap<ParamPtr, u32>,
     /// The remote control pages, as defined by the plugin. These don't reference any heap data so
     /// we can store them directly.
@@ -651,13 +653,15 @@ impl<P: ClapPlugin> nice_plug_core::context::gui::GuiContextInner for WrapperGui
 }
 
 /// A remote control section. The plugin can fill this with information for one or more pages.
-pub(crate) struct Section {
+/// A section of [`RemoteControlPages`].
+pub struct Section {
     pages: Vec<Page>,
 }
 
 /// A remote control page. These are automatically split into multiple pages if the number of
 /// controls exceeds 8.
-pub(crate) struct Page {
+/// A page of a [`Section`].
+pub struct Page {
     name: String,
     params: Vec<Option<ParamPtr>>,
 }
@@ -672,6 +676,18 @@ impl<'a> RemoteControlPages<'a> {
     ) {
         // The magic happens in the `add_section()` function defined below
         plugin.remote_controls(&mut Self {
+            pages,
+            param_ptr_to_hash,
+        });
+    }
+
+    /// The pages a [`ClapRemoteControls`] source defines, added to `pages`.
+    pub(crate) fn define_from_source(
+        source: &dyn crate::wrapper::clap::ClapRemoteControls,
+        pages: &'a mut Vec<clap_remote_controls_page>,
+        param_ptr_to_hash: &'a HashMap<ParamPtr, u32>,
+    ) {
+        source.pages(&mut Self {
             pages,
             param_ptr_to_hash,
         });

@@ -104,12 +104,12 @@ use super::descriptor::PluginDescriptor;
 use super::util::ClapPtr;
 use crate::event_loop::{BackgroundThread, EventLoop, MainThreadExecutor, TASK_QUEUE_CAPACITY};
 use crate::util::permit_alloc;
-use crate::wrapper::clap::ClapPlugin;
 use crate::wrapper::clap::context::RemoteControlPages;
 #[cfg(feature = "editor")]
 use crate::wrapper::clap::context::WrapperGuiContext;
 use crate::wrapper::clap::presets::{self, ClapPresetLoader};
 use crate::wrapper::clap::util::{read_stream, write_stream};
+use crate::wrapper::clap::{ClapPlugin, ClapRemoteControls};
 use crate::wrapper::state::{self};
 use crate::wrapper::util::buffer_management::{BufferManager, ChannelPointers};
 use crate::wrapper::util::{clamp_input_event_timing, hash_param_id, process_wrapper, strlcpy};
@@ -264,6 +264,8 @@ pub struct Wrapper<P: ClapPlugin> {
     /// tasks ([`Self::refresh_remote_controls`]), so the pages can follow what the plugin plays.
     remote_control_pages: AtomicRefCell<Vec<clap_remote_controls_page>>,
     host_remote_controls: AtomicRefCell<Option<ClapPtr<clap_host_remote_controls>>>,
+    /// Where the pages are asked again without locking the plugin (patch 10).
+    remote_controls_source: Option<Arc<dyn ClapRemoteControls>>,
 
     /// Preset load (patch 9): what the plugin gave to load presets with, if anything.
     preset_loader: Option<Box<dyn ClapPresetLoader>>,
@@ -509,13 +511,25 @@ impl<P: ClapPlugin> Wrapper<P> {
     /// (`clap_host_remote_controls::changed`). Main thread only.
     fn refresh_remote_controls(&self) {
         let mut pages = Vec::new();
-        match self.plugin.try_lock() {
-            Some(plugin) => RemoteControlPages::define_remote_control_pages(
-                &*plugin,
+        if let Some(source) = &self.remote_controls_source {
+            // The plugin's shared state, not the plugin: the audio thread may hold its lock.
+            RemoteControlPages::define_from_source(
+                source.as_ref(),
                 &mut pages,
                 &self.param_ptr_to_hash,
-            ),
-            None => return,
+            );
+        } else {
+            if self.is_processing.load(Ordering::SeqCst) {
+                return;
+            }
+            match self.plugin.try_lock() {
+                Some(plugin) => RemoteControlPages::define_remote_control_pages(
+                    &*plugin,
+                    &mut pages,
+                    &self.param_ptr_to_hash,
+                ),
+                None => return,
+            }
         }
         let same = |a: &clap_remote_controls_page, b: &clap_remote_controls_page| {
             a.section_name == b.section_name
@@ -637,6 +651,7 @@ impl<P: ClapPlugin> Wrapper<P> {
         }
 
         let preset_loader = plugin.clap_preset_loader();
+        let remote_controls_source = plugin.clap_remote_controls();
 
         // Support for the remote controls extension
         let mut remote_control_pages = Vec::new();
@@ -771,6 +786,7 @@ impl<P: ClapPlugin> Wrapper<P> {
             },
             remote_control_pages: AtomicRefCell::new(remote_control_pages),
             host_remote_controls: AtomicRefCell::new(None),
+            remote_controls_source,
 
             preset_loader,
             clap_plugin_preset_load: clap_plugin_preset_load {
