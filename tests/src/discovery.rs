@@ -5,7 +5,6 @@
 
 use clack_extensions::preset_discovery::prelude::*;
 use clack_host::host::HostError;
-use clack_host::prelude::HostInfo;
 use std::ffi::{CStr, CString};
 use std::path::{Path, PathBuf};
 
@@ -194,13 +193,7 @@ fn files_at(path: &Path, extensions: &[String]) -> Vec<PathBuf> {
 /// every location it declares, every file of a declared type in its file locations.
 pub fn index() -> Index {
     let entry = crate::load_entry();
-    let info = HostInfo::new(
-        "Ressort end-to-end tests",
-        "Ressort",
-        "https://ressort.audio",
-        env!("CARGO_PKG_VERSION"),
-    )
-    .expect("host info");
+    let info = crate::host_info();
     let mut index = Index::default();
     let Some(factory) = entry.get_factory::<PresetDiscoveryFactory>() else {
         return index;

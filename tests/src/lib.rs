@@ -87,6 +87,17 @@ pub fn bundle_path() -> PathBuf {
 
 /// Loads the bundle's entry. Panics with the command that builds it when it is missing: the
 /// tests never skip silently.
+/// How the test host introduces itself to the plugin and to its preset providers.
+pub fn host_info() -> HostInfo {
+    HostInfo::new(
+        "Ressort end-to-end tests",
+        "Ressort",
+        "https://ressort.audio",
+        env!("CARGO_PKG_VERSION"),
+    )
+    .expect("host info")
+}
+
 pub fn load_entry() -> PluginEntry {
     let path = bundle_path();
     if !path.exists() {

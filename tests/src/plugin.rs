@@ -72,13 +72,7 @@ impl TestPlugin {
     pub fn new() -> TestPlugin {
         ROLE.with(|r| r.set(Role::Main));
         let entry = load_entry();
-        let info = HostInfo::new(
-            "Ressort end-to-end tests",
-            "Ressort",
-            "https://ressort.audio",
-            env!("CARGO_PKG_VERSION"),
-        )
-        .expect("host info");
+        let info = crate::host_info();
         let id = std::ffi::CString::new(PLUGIN_ID).expect("plugin id");
         let factory = entry
             .get_plugin_factory()

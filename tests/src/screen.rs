@@ -703,6 +703,20 @@ impl HostWindow {
         Ok(HostWindow { conn, window })
     }
 
+    /// The first window embedded in this one (an editor's), waiting up to `timeout` for it.
+    pub fn embedded(&self, timeout: Duration) -> Option<Window> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if let Some(&child) = self.children().first() {
+                return Some(child);
+            }
+            if Instant::now() >= deadline {
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
     /// The windows embedded in this one.
     pub fn children(&self) -> Vec<Window> {
         self.conn

@@ -37,17 +37,9 @@ fn the_editor_opens_in_a_clap_host_and_shows_sidechain_strikes() {
     plugin.activate(48_000.0, 1, 512);
 
     // The editor's window is embedded in the host's.
-    let deadline = Instant::now() + Duration::from_secs(20);
-    let editor = loop {
-        if let Some(&child) = host.children().first() {
-            break child;
-        }
-        assert!(
-            Instant::now() < deadline,
-            "the editor never embedded its window"
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    };
+    let editor = host
+        .embedded(Duration::from_secs(20))
+        .expect("the editor embeds its window within 20 s");
 
     // Strike the default preset (the 15 × 15 mesh, in1 = force on its hammer) through the
     // sidechain, in real time, until the motion view shows it.

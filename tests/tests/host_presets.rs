@@ -289,17 +289,9 @@ fn a_preset_loaded_by_the_host_plays_as_chosen_in_the_editor() {
         .open_editor(host.window)
         .expect("the editor opens");
     by_editor.activate(48_000.0, 1, 512);
-    let deadline = Instant::now() + Duration::from_secs(20);
-    let editor = loop {
-        if let Some(&child) = host.children().first() {
-            break child;
-        }
-        assert!(
-            Instant::now() < deadline,
-            "the editor never embedded its window"
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    };
+    let editor = host
+        .embedded(Duration::from_secs(20))
+        .expect("the editor embeds its window within 20 s");
     for _ in 0..20 {
         by_editor.render(0.05, 480, &Score::new());
         by_editor.idle();

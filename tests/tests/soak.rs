@@ -32,11 +32,10 @@
 
 use ressort_tests::fixtures;
 use ressort_tests::presets::presets;
-use ressort_tests::screen::{HostWindow, Xvfb};
+use ressort_tests::screen::{in_private_display, HostWindow};
 use ressort_tests::{state, thread_count, ClapId, ParamDesc, Score, Stereo, TestPlugin};
 use std::time::{Duration, Instant};
 
-const DISPLAY_ENV: &str = "RESSORT_TEST_DISPLAY";
 /// Episodes of the CI run.
 const EPISODES: u64 = 240;
 /// The CI run's seed.
@@ -424,28 +423,9 @@ fn soak(display: Option<&str>, seed: u64, episodes: u64) -> Counters {
 #[test]
 fn a_long_random_session_breaks_nothing() {
     let name = "a_long_random_session_breaks_nothing";
-    let Ok(display) = std::env::var(DISPLAY_ENV) else {
-        // The session runs in a child process that owns a private X server, so that the
-        // editor can open and an abort ends the child, not the test harness.
-        let x = Xvfb::start(1280, 800).expect("Xvfb starts (scripts/setup.sh installs xvfb)");
-        let out = std::process::Command::new(std::env::current_exe().expect("the test binary"))
-            .args([name, "--exact", "--nocapture", "--test-threads=1"])
-            .env(DISPLAY_ENV, x.display())
-            .env("DISPLAY", x.display())
-            .output()
-            .expect("run the session in a child process");
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        print!("{stdout}");
-        eprint!("{}", String::from_utf8_lossy(&out.stderr));
-        assert!(
-            out.status.success(),
-            "the soak session failed: {}",
-            out.status
-        );
-        assert!(
-            stdout.contains(&format!("test {name} ... ")) && stdout.contains("1 passed"),
-            "the child process did not run `{name}`"
-        );
+    // The session runs in a child process that owns a private X server, so that the editor
+    // can open and an abort ends the child, not the test harness.
+    let Some(display) = in_private_display(name, 1280, 800) else {
         return;
     };
     let seed = match std::env::var("RESSORT_SOAK_SEED").ok().as_deref() {

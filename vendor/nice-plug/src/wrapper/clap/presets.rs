@@ -112,7 +112,7 @@ pub trait ClapPresetLoader: Send + Sync {
 }
 
 /// A string for C: interior NULs are dropped rather than refusing the whole string.
-fn c_string(s: &str) -> CString {
+pub(crate) fn c_string(s: &str) -> CString {
     CString::new(s.replace('\0', "")).unwrap_or_default()
 }
 

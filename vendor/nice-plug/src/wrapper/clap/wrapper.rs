@@ -3477,8 +3477,7 @@ impl<P: ClapPlugin> Wrapper<P> {
                     unsafe_clap_call! { host=>loaded(&*wrapper.host_callback, location_kind, location, load_key) };
                 }
                 Err(message) => {
-                    let message =
-                        std::ffi::CString::new(message.replace('\0', "")).unwrap_or_default();
+                    let message = presets::c_string(message);
                     unsafe_clap_call! { host=>on_error(&*wrapper.host_callback, location_kind, location, load_key, 0, message.as_ptr()) };
                 }
             }
