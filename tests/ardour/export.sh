@@ -46,9 +46,25 @@ step() {
   local name="$1"
   shift
   local t0=$SECONDS
-  if ! "$@" >"$out/logs/$name.out" 2>"$out/logs/$name.err"; then
+  local tries=0 status=0
+  # Ardour's headless tools crash now and then before doing anything (a segmentation fault,
+  # about one run in three on the Nov 28 machine): a crash is run again, twice at most; a tool
+  # that ends with an error, or a render that differs, is never retried.
+  while true; do
+    status=0
+    "$@" >"$out/logs/$name.out" 2>"$out/logs/$name.err" || status=$?
+    if [ "$status" -eq 139 ] && [ "$tries" -lt 2 ]; then
+      tries=$((tries + 1))
+      echo "ardour: $name crashed (SIGSEGV), running it again ($tries)" >&2
+      # The build starts its session afresh; the crashed run may have left half of one.
+      if [ "$name" = build ]; then rm -rf "$out/session"; fi
+      continue
+    fi
+    break
+  done
+  if [ "$status" -ne 0 ]; then
     echo "ardour: $name failed:" >&2
-    tail -20 "$out/logs/$name.out" "$out/logs/$name.err" >&2
+    tail -n 20 "$out/logs/$name.out" "$out/logs/$name.err" >&2
     exit 1
   fi
   grep -h '^\[ressort\]' "$out/logs/$name.out" | sed "s/^/ardour: $name: /" || true
