@@ -74,6 +74,20 @@ pub trait Arith {
         yes: impl FnOnce(&Self) -> Self::F,
         no: impl FnOnce(&Self) -> Self::F,
     ) -> Self::F;
+
+    /// [`Arith::branch`] for a vector of `N` values: `yes()` where `c` holds, else `no()`.
+    /// By default both sides are computed and selected (what vectors whose lanes differ do);
+    /// scalars jump.
+    #[inline(always)]
+    fn branch_v<const N: usize>(
+        &self,
+        c: Self::M,
+        yes: impl FnOnce(&Self) -> [Self::F; N],
+        no: impl FnOnce(&Self) -> [Self::F; N],
+    ) -> [Self::F; N] {
+        let (y, n) = (yes(self), no(self));
+        std::array::from_fn(|i| self.select(c, y[i], n[i]))
+    }
 }
 
 /// The plain `f64` arithmetic of the reference kernels.
@@ -175,6 +189,19 @@ impl Arith for Scalar {
         yes: impl FnOnce(&Self) -> f64,
         no: impl FnOnce(&Self) -> f64,
     ) -> f64 {
+        if c {
+            yes(self)
+        } else {
+            no(self)
+        }
+    }
+    #[inline(always)]
+    fn branch_v<const N: usize>(
+        &self,
+        c: bool,
+        yes: impl FnOnce(&Self) -> [f64; N],
+        no: impl FnOnce(&Self) -> [f64; N],
+    ) -> [f64; N] {
         if c {
             yes(self)
         } else {

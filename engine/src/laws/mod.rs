@@ -19,6 +19,8 @@ mod cubic;
 pub(crate) mod linear;
 pub(crate) mod nodes;
 pub(crate) use classes::{ArgClass, NUM_ARG_CLASSES};
+/// The 3-D laws (3-D spec §2), their own table.
+pub mod space;
 mod table;
 
 // The laws, one file each.

@@ -33,9 +33,7 @@ impl Law for NlContact {
         let (s, c, k, z, t) = (p(0), p(1), p(2), p(3), p(4));
         let zero = a.num(0.0);
         let d = a.add(dx, t);
-        let swap = a.lt(k, s);
-        let (k, c) = (a.select(swap, s, k), a.select(swap, zero, c));
-        let f = a.add(cubic::force(a, d, s, c, k).0, a.mul(z, dv));
+        let f = a.add(elastic(a, d, s, c, k), a.mul(z, dv));
         a.select(a.gt(d, zero), f, zero)
     }
 
@@ -59,6 +57,16 @@ impl Law for NlContact {
         // `k < s` turns the cubic off.
         (p[1] < 0.0 && !(p[2] < p[0])).then_some(BoundNote::NegativeCubic)
     }
+}
+
+/// The contact's elastic force f_e(d) for the penetration `d`: the bounded cubic with the
+/// k < s fix (k ← s, c ← 0). The 3-D sphere contact applies it to the elongation ℓ − D
+/// (3-D spec §2.3.2).
+#[inline(always)]
+pub(crate) fn elastic<A: Arith>(a: &A, d: A::F, s: A::F, c: A::F, k: A::F) -> A::F {
+    let swap = a.lt(k, s);
+    let (k, c) = (a.select(swap, s, k), a.select(swap, a.num(0.0), c));
+    cubic::force(a, d, s, c, k).0
 }
 
 #[cfg(test)]
