@@ -351,6 +351,7 @@ fn spec() -> impl Strategy<Value = ModelSpec> {
                     .map(|s| s.to_string())
                     .collect(),
                 host: Default::default(),
+                space: None,
             }
         })
 }

@@ -274,13 +274,18 @@ impl<'a> Cx<'a> {
                 );
                 None
             }
-            (Endpoint::Line { .. } | Endpoint::Surface { .. }, Symbol::Element(j, Role::Macro)) => {
+            (
+                Endpoint::Line { .. } | Endpoint::Surface { .. } | Endpoint::Volume { .. },
+                Symbol::Element(j, Role::Macro),
+            ) => {
                 let ElementKind::Macro(mac) = &self.spec.elements[j].kind else {
                     return None;
                 };
                 let (coords, found_count): (Vec<&Expr>, usize) = match ep {
                     Endpoint::Line { alpha, .. } => (vec![alpha], 1),
                     Endpoint::Surface { u, w, .. } => (vec![u, w], 2),
+                    // A lattice's bracket (3-D models only): the count is reported below.
+                    Endpoint::Volume { coords, .. } => (coords.iter().collect(), 3),
                     Endpoint::Label(_) => return None,
                 };
                 let expected = if mac.kind.is_2d() { 2 } else { 1 };
@@ -314,7 +319,7 @@ impl<'a> Cx<'a> {
                 self.proxy_coords.push((element, [coords[0], second]));
                 Some((proxy_base + index) as u32)
             }
-            (Endpoint::Line { .. } | Endpoint::Surface { .. }, _) => {
+            (Endpoint::Line { .. } | Endpoint::Surface { .. } | Endpoint::Volume { .. }, _) => {
                 self.error(
                     Some(element),
                     CompileErrorKind::NotAMacro(target.to_string()),

@@ -235,6 +235,11 @@ fn describe_endpoint(ep: &Endpoint) -> String {
         Endpoint::Surface { target, u, w } => {
             format!("[@{target} {} {}]", bracket_coord(u), bracket_coord(w))
         }
+        Endpoint::Volume { target, coords } => {
+            let [u, v, w] = &**coords;
+            let (u, v, w) = (bracket_coord(u), bracket_coord(v), bracket_coord(w));
+            format!("[@{target} {u} {v} {w}]")
+        }
     }
 }
 

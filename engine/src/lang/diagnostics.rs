@@ -114,8 +114,20 @@ pub enum DiagnosticCode {
     BareMacroReference,
     /// An unknown type keyword (spec §3.12 a).
     UnknownKeyword,
-    /// Two conflicting `~samplerate` directives (spec §3.11).
+    /// Two conflicting `~samplerate` directives (spec §3.11), or two `~dim`, `~gravity` or
+    /// `~friction` lines (3-D spec §1.1, §1.10).
     ConflictingDirective,
+    /// An element or directive of the other dimension: a 1-D element (`massG`, `string`,
+    /// `mesh`, `~generate`…) in a `~dim 3` script, or a 3-D one (`vdamper`, `string3`,
+    /// `~gravity`…) in a 1-D script (3-D spec §1.1, §1.8).
+    DimensionMismatch,
+    /// A mesh file that cannot be read, or an error inside it (3-D spec §4.6): the message
+    /// gives the file's line.
+    MeshFile,
+    /// A structure option that is unknown, given twice, or of the wrong form (3-D spec §4.0).
+    InvalidOption,
+    /// A constant direction that is the zero vector (3-D spec §1.7).
+    ZeroDirection,
 
     // ---- warnings -------------------------------------------------------------------------
     /// A separator `+` directly between two non-blank characters, e.g. `a+b` (spec §3.3).
@@ -130,6 +142,10 @@ pub enum DiagnosticCode {
     ScopeAlreadyOpen,
     /// More diagnostics than the front end records; the rest are counted but not listed.
     TooManyDiagnostics,
+    /// A legal 3-D value that is probably a mistake (3-D spec §5.6, §4.6): a 1-D line's
+    /// damping read as a rest length, a string without tension, a contact that cannot engage,
+    /// a mesh vertex no face uses.
+    SuspiciousValue,
 
     // ---- notes ----------------------------------------------------------------------------
     /// A connection point in the legacy proxy syntax of the MIMS proxy branch, a bare macro
@@ -143,7 +159,7 @@ pub enum DiagnosticCode {
 
 impl DiagnosticCode {
     /// Every category, in declaration order (errors first, then warnings, then notes).
-    pub const ALL: [DiagnosticCode; 42] = [
+    pub const ALL: [DiagnosticCode; 47] = [
         DiagnosticCode::InvalidUtf8,
         DiagnosticCode::UnterminatedBracket,
         DiagnosticCode::NestedBracket,
@@ -178,12 +194,17 @@ impl DiagnosticCode {
         DiagnosticCode::BareMacroReference,
         DiagnosticCode::UnknownKeyword,
         DiagnosticCode::ConflictingDirective,
+        DiagnosticCode::DimensionMismatch,
+        DiagnosticCode::MeshFile,
+        DiagnosticCode::InvalidOption,
+        DiagnosticCode::ZeroDirection,
         DiagnosticCode::PlusSeparator,
         DiagnosticCode::IgnoredCommandLike,
         DiagnosticCode::UnknownDirective,
         DiagnosticCode::ScopeNotOpen,
         DiagnosticCode::ScopeAlreadyOpen,
         DiagnosticCode::TooManyDiagnostics,
+        DiagnosticCode::SuspiciousValue,
         DiagnosticCode::LegacyProxySyntax,
         DiagnosticCode::LegacyMacroVelocity,
     ];
@@ -194,7 +215,7 @@ impl DiagnosticCode {
         match self {
             LegacyProxySyntax | LegacyMacroVelocity => Severity::Note,
             PlusSeparator | IgnoredCommandLike | UnknownDirective | ScopeNotOpen
-            | ScopeAlreadyOpen | TooManyDiagnostics => Severity::Warning,
+            | ScopeAlreadyOpen | TooManyDiagnostics | SuspiciousValue => Severity::Warning,
             _ => Severity::Error,
         }
     }
@@ -237,12 +258,17 @@ impl DiagnosticCode {
             BareMacroReference => "bare-macro-reference",
             UnknownKeyword => "unknown-keyword",
             ConflictingDirective => "conflicting-directive",
+            DimensionMismatch => "dimension-mismatch",
+            MeshFile => "mesh-file",
+            InvalidOption => "invalid-option",
+            ZeroDirection => "zero-direction",
             PlusSeparator => "plus-separator",
             IgnoredCommandLike => "ignored-command-like-line",
             UnknownDirective => "unknown-directive",
             ScopeNotOpen => "scope-not-open",
             ScopeAlreadyOpen => "scope-already-open",
             TooManyDiagnostics => "too-many-diagnostics",
+            SuspiciousValue => "suspicious-value",
             LegacyProxySyntax => "legacy-proxy-syntax",
             LegacyMacroVelocity => "legacy-macro-velocity",
         }

@@ -45,6 +45,9 @@ pub(crate) struct ExprContext<'a> {
     pub symbols: &'a Symbols<'a>,
     pub line: u32,
     pub label: Option<&'a str>,
+    /// `auto` (3-D spec §1.7): `None` in a 1-D script, where it is an ordinary name; in a 3-D
+    /// script a reserved word, allowed (`Some(true)`) only in a length slot.
+    pub auto: Option<bool>,
 }
 
 struct ExprParser<'a, 'd> {
@@ -364,6 +367,21 @@ impl ExprParser<'_, '_> {
 
     /// Resolves a name that is not called (spec §3.5).
     fn name(&mut self, name: &str, col: u32) {
+        match (name, self.cx.auto) {
+            ("auto", Some(true)) => return,
+            ("auto", Some(false)) => {
+                self.failed = true;
+                self.error_at(
+                    DiagnosticCode::UndefinedName,
+                    col,
+                    "`auto` is the endpoints' distance at stage 0: it stands only in a rest \
+                     length L, a contact distance D or a bubble's radius R (3-D spec §1.7)"
+                        .to_string(),
+                );
+                return;
+            }
+            _ => {}
+        }
         if Func::from_name(name).is_some() {
             self.failed = true;
             self.error_at(
@@ -505,6 +523,7 @@ mod tests {
             symbols: &symbols,
             line: 1,
             label: None,
+            auto: None,
         };
         let mut d = Diags::default();
         let e = parse_expression(s, 1, &cx, &mut d);

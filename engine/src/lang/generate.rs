@@ -300,6 +300,7 @@ pub(crate) fn expand(
         symbols,
         line: req.line,
         label,
+        auto: None,
     };
     let eval = |key: &str, v: &Val, diags: &mut Diags| -> Option<f64> {
         let e = parse_expression(&v.value, v.col, &cx, diags)?;

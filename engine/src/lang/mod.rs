@@ -41,12 +41,16 @@ mod lexer;
 mod numbers;
 mod parser;
 mod printer;
+mod space_printer;
 mod symbols;
 
 pub use diagnostics::{Diagnostic, DiagnosticCode, Severity, MAX_DIAGNOSTICS};
 pub use expr_parser::MAX_NESTING;
 pub use generate::MAX_GENERATED_ELEMENTS;
-pub use parser::{parse, parse_bytes, MAX_EXCITERS, MAX_MACRO_NODES, MAX_OPEN_SCOPES};
+pub use parser::{
+    parse, parse_bytes, parse_bytes_with_files, parse_with_files, Files, MAX_EXCITERS,
+    MAX_MACRO_NODES, MAX_OPEN_SCOPES,
+};
 pub use printer::print;
 
 use crate::spec::ModelSpec;

@@ -31,7 +31,10 @@ mod keywords;
 mod labels;
 mod lines;
 mod params;
+mod space;
 mod values;
+
+pub use space::labels::Files;
 
 /// The most nodes one macro may have: 1 048 576 (the compiler's point limit).
 pub const MAX_MACRO_NODES: u64 = 1 << 20;
@@ -42,17 +45,36 @@ pub const MAX_OPEN_SCOPES: usize = 64;
 
 pub use directives::MAX_EXCITERS;
 
-/// Parses script text (spec §3). See [`Parsed`].
+/// Parses script text (spec §3). See [`Parsed`]. A 3-D script that imports a mesh file
+/// (`objMesh`) needs [`parse_with_files`].
 pub fn parse(text: &str) -> Parsed {
-    parse_with(text, Diags::default())
+    parse_with(text, Diags::default(), &no_files)
+}
+
+/// Parses script text whose `objMesh` lines read their files through `files` (3-D spec
+/// §4.6): it gets the path as written and returns the file's text or why it cannot.
+pub fn parse_with_files(text: &str, files: Files<'_>) -> Parsed {
+    parse_with(text, Diags::default(), files)
+}
+
+/// The files of a script that was not read from a folder.
+fn no_files(path: &str) -> Result<String, String> {
+    Err(format!(
+        "no file `{path}`: this script was not read from a folder, so it cannot import files"
+    ))
 }
 
 /// Parses script bytes: invalid UTF-8 is reported with its line and column (each invalid
 /// sequence reads as one U+FFFD character), and the rest is parsed as text (spec §3.12 f).
 /// Adjacent invalid sequences are one report, the only one of its line.
 pub fn parse_bytes(bytes: &[u8]) -> Parsed {
+    parse_bytes_with_files(bytes, &no_files)
+}
+
+/// [`parse_bytes`] with the files of [`parse_with_files`].
+pub fn parse_bytes_with_files(bytes: &[u8], files: Files<'_>) -> Parsed {
     if let Ok(text) = std::str::from_utf8(bytes) {
-        return parse_with(text, Diags::default());
+        return parse_with(text, Diags::default(), files);
     }
     let mut diags = Diags::default();
     let mut text = String::with_capacity(bytes.len());
@@ -94,7 +116,7 @@ pub fn parse_bytes(bytes: &[u8]) -> Parsed {
     if let Some(r) = run.take() {
         report(&mut diags, r);
     }
-    parse_with(&text, diags)
+    parse_with(&text, diags, files)
 }
 
 /// A running 1-based line and column, with the line breaks of spec §3.2 (CR LF, CR, LF).
@@ -131,10 +153,17 @@ impl Position {
     }
 }
 
-fn parse_with(text: &str, mut diags: Diags) -> Parsed {
+fn parse_with(text: &str, mut diags: Diags, files: Files<'_>) -> Parsed {
     // The tokens borrow the script's text.
     let (mut items, tokens) = lines::read_items(text, &mut diags);
-    let symbols = labels::declare_labels(&mut items, &tokens, &mut diags);
+    // A 3-D script (`~dim 3`, 3-D spec §1.1) is read with the 3-D keywords.
+    let three_d = space::is_3d(&items, &tokens);
+    let mut pass1 = three_d.then(|| space::labels::Pass1::new(files));
+    let mut symbols = labels::declare_labels(&mut items, &tokens, &mut diags, pass1.as_mut());
+    let mesh_errors = match pass1 {
+        Some(p) => p.finish(&mut symbols, &mut diags),
+        None => Vec::new(),
+    };
 
     // Pass 2: directives and commands in script order.
     let mut b = Builder {
@@ -148,26 +177,38 @@ fn parse_with(text: &str, mut diags: Diags) -> Parsed {
         open: Vec::new(),
         buffer_ids: HashMap::new(),
         samplerate: None,
+        space: three_d.then(space::SpaceState::default),
+        auto: three_d.then_some(false),
+        mesh_errors,
     };
     for item in items.iter().filter(|i| !i.broken) {
-        if let Some(req) = &item.generator {
+        if three_d && is_generate(item, &tokens) {
+            b.generate_in_3d(item);
+        } else if let Some(req) = &item.generator {
             b.generate(req);
         } else if is_generate(item, &tokens) {
             // Reported in pass 1.
         } else if item.directive {
             b.directive(item);
+        } else if three_d {
+            b.space_command(item);
         } else {
             b.command(item);
         }
     }
+    b.finish_space();
     let Builder {
         diags,
         mut spec,
         samplerate,
+        space,
         ..
     } = b;
     if let Some((mode, _)) = samplerate {
         spec.sample_rate_mode = mode;
+    }
+    if let Some(state) = space {
+        spec.space = Some(Box::new(state.spec));
     }
     let ok = diags.error_count() == 0;
     Parsed {
@@ -188,6 +229,13 @@ struct Builder<'s> {
     /// `spec.buffers` by name.
     buffer_ids: HashMap<String, u32>,
     samplerate: Option<(SampleRateMode, u32)>,
+    /// The 3-D model being read (`~dim 3`), `None` for a 1-D script.
+    space: Option<space::SpaceState>,
+    /// Whether `auto` may stand in the expression being read: `None` in a 1-D script (where it
+    /// is an ordinary name), `Some(true)` in a 3-D length slot (3-D spec §1.7).
+    auto: Option<bool>,
+    /// Why each `objMesh`'s file could not be read in pass 1, by label.
+    mesh_errors: Vec<(String, String)>,
 }
 
 /// Where a command stands, for diagnostics.
@@ -204,6 +252,18 @@ impl At<'_> {
 }
 
 impl Builder<'_> {
+    /// Runs `f` with `auto` allowed (a 3-D length slot) or not; in a 1-D script `auto` stays an
+    /// ordinary name.
+    fn with_auto<T>(&mut self, allowed: bool, f: impl FnOnce(&mut Self) -> T) -> T {
+        let before = self.auto;
+        if before.is_some() {
+            self.auto = Some(allowed);
+        }
+        let out = f(self);
+        self.auto = before;
+        out
+    }
+
     /// The index of buffer `name` in `spec.buffers`, added at its first use.
     fn buffer_index(&mut self, name: &str) -> u32 {
         if let Some(&i) = self.buffer_ids.get(name) {

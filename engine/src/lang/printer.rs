@@ -96,7 +96,7 @@ fn needs_brackets(text: &str) -> bool {
 }
 
 /// An expression in an argument slot: bare when it has no space or `+`, else `[ … ]`.
-fn arg(e: &Expr) -> String {
+pub(super) fn arg(e: &Expr) -> String {
     let t = expr_text(e);
     if needs_brackets(&t) {
         format!("[{t}]")
@@ -106,7 +106,7 @@ fn arg(e: &Expr) -> String {
 }
 
 /// An item of a vector or connection bracket: parenthesised when it has spaces (§3.3).
-fn item(e: &Expr) -> String {
+pub(super) fn item(e: &Expr) -> String {
     let t = expr_text(e);
     if t.contains(' ') {
         format!("({t})")
@@ -115,7 +115,7 @@ fn item(e: &Expr) -> String {
     }
 }
 
-fn vector(v: &Vector) -> String {
+pub(super) fn vector(v: &Vector) -> String {
     match v {
         Vector::Scalar(e) => {
             let t = expr_text(e);
@@ -132,15 +132,19 @@ fn vector(v: &Vector) -> String {
     }
 }
 
-fn endpoint(e: &Endpoint) -> String {
+pub(super) fn endpoint(e: &Endpoint) -> String {
     match e {
         Endpoint::Label(l) => format!("@{l}"),
         Endpoint::Line { target, alpha } => format!("[@{target} {}]", item(alpha)),
         Endpoint::Surface { target, u, w } => format!("[@{target} {} {}]", item(u), item(w)),
+        Endpoint::Volume { target, coords } => {
+            let [u, v, w] = &**coords;
+            format!("[@{target} {} {} {}]", item(u), item(v), item(w))
+        }
     }
 }
 
-fn is_zero(e: &Expr) -> bool {
+pub(super) fn is_zero(e: &Expr) -> bool {
     *e == Expr::Num(0.0)
 }
 
@@ -298,11 +302,32 @@ pub fn print(spec: &ModelSpec) -> String {
         }
     };
     let name = |i: u32| spec.buffers.get(i as usize).map_or("", String::as_str);
-    for e in &spec.elements {
-        let (line, tag) = element_line(e, spec);
+    // Each element's line and buffers (a 3-D model's elements are in its space).
+    let lines: Vec<(String, Option<u32>, &[u32])> = match &spec.space {
+        Some(space) => space
+            .elements
+            .iter()
+            .map(|e| {
+                (
+                    super::space_printer::element_line(e, space),
+                    None,
+                    e.buffers.as_slice(),
+                )
+            })
+            .collect(),
+        None => spec
+            .elements
+            .iter()
+            .map(|e| {
+                let (line, tag) = element_line(e, spec);
+                (line, tag, e.buffers.as_slice())
+            })
+            .collect(),
+    };
+    for (line, tag, buffers) in lines {
         let wanted: Vec<u32> = match tag {
-            Some(_) => e.buffers.get(..e.buffers.len() - 1).unwrap_or(&[]).to_vec(),
-            None => e.buffers.clone(),
+            Some(_) => buffers.get(..buffers.len() - 1).unwrap_or(&[]).to_vec(),
+            None => buffers.to_vec(),
         };
         let common = open.iter().zip(&wanted).take_while(|(a, b)| a == b).count();
         for &b in open.get(common..).unwrap_or(&[]).iter().rev() {
@@ -325,6 +350,9 @@ pub fn print(spec: &ModelSpec) -> String {
     }
 
     let mut out = String::new();
+    if let Some(space) = &spec.space {
+        out.push_str(&super::space_printer::medium(space));
+    }
     if spec.sample_rate_mode == SampleRateMode::Raw {
         out.push_str("~samplerate raw\n");
     }

@@ -2,9 +2,12 @@
 //! (spec §3.4), for name resolution and endpoint checks.
 
 use crate::spec::label_map::LabelMap;
+use crate::spec::space::structures::{self, Counts};
+use crate::spec::space::{MeshData, StructureKind};
 use std::borrow::Cow;
 use std::collections::hash_map::Entry;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
 
 /// What a label names, for name resolution and endpoint checks (spec §3.4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,6 +63,25 @@ pub(crate) struct Symbols<'a> {
     /// `<name>_…` that is not declared otherwise resolves to [`SymKind::Unknown`] and
     /// references to it are not reported again (no cascades).
     broken_generators: HashSet<String>,
+    /// The structures and adders of a 3-D script (3-D spec §4.0, §4.7), by label: the labels
+    /// they create (`s_m12`, `s_r3`, `h_7`) are resolved from their counts rather than stored
+    /// one by one.
+    generators: HashMap<String, Generated>,
+}
+
+/// What a 3-D structure or adder creates, for resolving its labels.
+#[derive(Clone, Debug)]
+pub(crate) struct Generated {
+    /// The generator, with its sizes; `None` for an adder (`contactSet`, `vdampers`), whose
+    /// labels are `<name>_<k>` for `k < adds`.
+    pub structure: Option<(StructureKind, Vec<u32>)>,
+    pub counts: Counts,
+    /// The links an adder creates.
+    pub adds: u64,
+    pub line: u32,
+    pub col: u32,
+    /// objMesh: the file, read in pass 1.
+    pub mesh: Option<Arc<MeshData>>,
 }
 
 impl<'a> Symbols<'a> {
@@ -80,12 +102,76 @@ impl<'a> Symbols<'a> {
             .char_indices()
             .filter(|&(_, c)| c == '_')
             .any(|(i, _)| self.broken_generators.contains(name.get(..i).unwrap_or("")));
-        under_broken.then_some(Symbol {
-            kind: SymKind::Unknown,
-            line: 0,
-            col: 0,
-            generated: true,
-        })
+        if under_broken {
+            return Some(Symbol {
+                kind: SymKind::Unknown,
+                line: 0,
+                col: 0,
+                generated: true,
+            });
+        }
+        self.generated(name).map(|(_, symbol)| symbol)
+    }
+
+    /// The 3-D structure or adder that creates the label `name`, and what the label names: a
+    /// node (`s_m12`) is a point, a link (`s_r3`, `h_7`) an interaction.
+    pub(crate) fn generated<'n>(&self, name: &'n str) -> Option<(&'n str, Symbol)> {
+        if self.generators.is_empty() {
+            return None;
+        }
+        for (i, _) in name.char_indices().filter(|&(_, c)| c == '_') {
+            let (owner, suffix) = (name.get(..i)?, name.get(i + 1..)?);
+            let Some(g) = self.generators.get(owner) else {
+                continue;
+            };
+            let kind = match &g.structure {
+                Some((kind, sizes)) => {
+                    let node = suffix.strip_prefix('m').is_some_and(|s| {
+                        structures::parse_node(*kind, sizes, g.counts.nodes, s).is_some()
+                    });
+                    if node {
+                        SymKind::Point
+                    } else if structures::is_link_label(&g.counts, suffix) {
+                        SymKind::Interaction
+                    } else {
+                        continue;
+                    }
+                }
+                None => {
+                    let ok = !suffix.is_empty()
+                        && suffix.chars().all(|c| c.is_ascii_digit())
+                        && (suffix == "0" || !suffix.starts_with('0'))
+                        && suffix.parse::<u64>().is_ok_and(|k| k < g.adds);
+                    if !ok {
+                        continue;
+                    }
+                    SymKind::Interaction
+                }
+            };
+            let symbol = Symbol {
+                kind,
+                line: g.line,
+                col: g.col,
+                generated: true,
+            };
+            return Some((owner, symbol));
+        }
+        None
+    }
+
+    /// Records a 3-D structure or adder labelled `name`.
+    pub(crate) fn insert_generator(&mut self, name: &str, g: Generated) {
+        self.generators.insert(name.to_string(), g);
+    }
+
+    /// The 3-D structure or adder labelled `name`.
+    pub(crate) fn generator(&self, name: &str) -> Option<&Generated> {
+        self.generators.get(name)
+    }
+
+    /// Every declared label, for the collision check against generated ones.
+    pub(crate) fn declared_labels(&self) -> impl Iterator<Item = (&str, &Symbol)> {
+        self.map.iter().map(|(k, v)| (k.as_ref(), v))
     }
 
     /// The symbol declared as `name`, ignoring broken generators.

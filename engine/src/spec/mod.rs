@@ -20,6 +20,7 @@ pub mod generators;
 mod host;
 pub(crate) mod label_map;
 pub mod reference;
+pub mod space;
 pub use builder::ModelBuilder;
 pub use host::{ExciterDecl, ExciterKind, HostSpec, MacroRange, Route, RouteSource};
 
@@ -160,6 +161,11 @@ pub enum Endpoint {
         u: Box<Expr>,
         w: Box<Expr>,
     },
+    /// `[@c u v w]` on a 3-D lattice (3-D spec §2.6): trilinear.
+    Volume {
+        target: Label,
+        coords: Box<[Expr; 3]>,
+    },
 }
 
 impl Endpoint {
@@ -189,7 +195,9 @@ impl Endpoint {
     pub fn target(&self) -> &str {
         match self {
             Endpoint::Label(l) => l,
-            Endpoint::Line { target, .. } | Endpoint::Surface { target, .. } => target,
+            Endpoint::Line { target, .. }
+            | Endpoint::Surface { target, .. }
+            | Endpoint::Volume { target, .. } => target,
         }
     }
 }
@@ -529,9 +537,17 @@ pub struct ModelSpec {
     /// How a host plays the model (`~pitch`, `~key`, `~note`, `~route`, `~macro`). The
     /// engine ignores it.
     pub host: HostSpec,
+    /// A 3-D model's medium and elements (`~dim 3`, 3-D spec §1.1); `elements` is then
+    /// empty. `None` for a 1-D model.
+    pub space: Option<Box<space::SpaceSpec>>,
 }
 
 impl ModelSpec {
+    /// Whether the model is three-dimensional (`~dim 3`).
+    pub fn is_3d(&self) -> bool {
+        self.space.is_some()
+    }
+
     /// The element labelled `label`.
     pub fn element(&self, label: &str) -> Option<&Element> {
         self.elements.iter().find(|e| e.label == label)

@@ -56,6 +56,10 @@ impl Builder<'_> {
             self.host_directive(item, name, first.col, args);
             return;
         }
+        if matches!(name, "dim" | "gravity" | "friction") {
+            self.space_directive(name, first, args, at);
+            return;
+        }
         let expected = match name {
             "begin" | "end" => "a buffer name (an identifier)",
             "samplerate" => "`raw` or `scaled`",
@@ -67,8 +71,9 @@ impl Builder<'_> {
                         format!("unknown directive `~{name}` ignored"),
                     )
                     .with_expected(
-                        "~begin, ~end, ~samplerate, ~generate, ~pitch, ~key, ~note, ~route, \
-                         ~macro, ~voices, ~pressure, ~exciter or ~unpitched",
+                        "~begin, ~end, ~samplerate, ~generate, ~dim, ~pitch, ~key, ~note, \
+                         ~route, ~macro, ~voices, ~pressure, ~exciter or ~unpitched (3-D: \
+                         ~gravity, ~friction)",
                     )
                     .with_found(format!("~{name}")),
                 );

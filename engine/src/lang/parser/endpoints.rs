@@ -12,7 +12,7 @@ use crate::spec::{label, Endpoint};
 impl Builder<'_> {
     /// An endpoint or target (spec §3.4, §2.8): `@label` of a point, or `[@macro α]` /
     /// `[@mesh u w]`.
-    fn endpoint(&mut self, t: &Token, at: At<'_>) -> Option<Endpoint> {
+    pub(super) fn endpoint(&mut self, t: &Token, at: At<'_>) -> Option<Endpoint> {
         match t.kind {
             TokKind::Bare if t.starts_with_at() => {
                 let name = t.label();
@@ -38,10 +38,16 @@ impl Builder<'_> {
                         false
                     }
                     Some(SymKind::Macro { dims }) => {
-                        let example = if dims == 2 {
-                            format!("[@{name} u w]")
+                        let example = match dims {
+                            0 => format!("@{name}_m0"),
+                            3 => format!("[@{name} u v w]"),
+                            2 => format!("[@{name} u w]"),
+                            _ => format!("[@{name} α]"),
+                        };
+                        let example = if self.space.is_some() && dims != 0 {
+                            format!("`@{name}_m0` or `{example}`")
                         } else {
-                            format!("[@{name} α]")
+                            example
                         };
                         self.diags.push(
                             at.diag(
@@ -148,10 +154,13 @@ impl Builder<'_> {
                 ok = false;
             }
             Some(SymKind::Macro { dims }) if usize::from(dims) != found => {
-                let what = if dims == 2 {
-                    "a mesh takes 2 coordinates [@mesh u w]"
-                } else {
-                    "a string, chain or stiff string takes 1 coordinate [@s α]"
+                let what = match (dims, self.space.is_some()) {
+                    (0, _) => "an icosphere's or a mesh file's nodes are addressed by label,                                e.g. `@b_m3` (3-D spec §2.6); it takes no coordinate",
+                    (3, _) => "a lattice takes 3 coordinates [@c u v w]",
+                    (2, true) => "a membrane takes 2 coordinates [@me u w]",
+                    (1, true) => "a string or ring takes 1 coordinate [@s α]",
+                    (2, false) => "a mesh takes 2 coordinates [@mesh u w]",
+                    _ => "a string, chain or stiff string takes 1 coordinate [@s α]",
                 };
                 self.diags.push(
                     at.diag(
@@ -184,17 +193,21 @@ impl Builder<'_> {
                 ok = false;
             }
         }
-        if ok && !(found == 1 || found == 2) {
+        // A 3-D lattice takes three (3-D spec §2.6).
+        let most = if self.space.is_some() { 3 } else { 2 };
+        let count_in_range = (1..=most).contains(&found);
+        if ok && !count_in_range {
+            let expected = if most == 3 { "1, 2 or 3" } else { "1 or 2" };
             self.diags.push(
                 at.diag(
                     DiagnosticCode::WrongCoordinateCount,
                     t.col,
                     format!(
-                        "a connection point has 1 or 2 coordinates, found {found} (an \
+                        "a connection point has {expected} coordinates, found {found} (an \
                          expression with spaces goes in parentheses)"
                     ),
                 )
-                .with_expected("1 or 2")
+                .with_expected(expected)
                 .with_found(found.to_string()),
             );
             ok = false;
@@ -205,7 +218,7 @@ impl Builder<'_> {
             self.symbols.get(&target).map(|s| s.kind),
             Some(SymKind::Macro { dims }) if usize::from(dims) != found
         );
-        let count_ok = (found == 1 || found == 2) && !dims_mismatch;
+        let count_ok = count_in_range && !dims_mismatch;
         if !count_ok {
             return None;
         }
@@ -229,7 +242,12 @@ impl Builder<'_> {
                     u: Box::new(u),
                     w: Box::new(w),
                 }),
-                Err(_) => None,
+                Err(exprs) => <[Expr; 3]>::try_from(exprs)
+                    .ok()
+                    .map(|coords| Endpoint::Volume {
+                        target,
+                        coords: Box::new(coords),
+                    }),
             },
         }
     }

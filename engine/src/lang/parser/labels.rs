@@ -2,6 +2,7 @@
 
 use super::keywords::{shape_of, sym_kind};
 use super::lines::{is_generate, Item};
+use super::space::labels::Pass1;
 use crate::lang::diagnostics::{Diagnostic, DiagnosticCode, Diags};
 use crate::lang::generate::{self, GenRequest, Read, MAX_GENERATED_ELEMENTS};
 use crate::lang::lexer::{TokKind, Token};
@@ -10,14 +11,22 @@ use crate::lang::symbols::{SymKind, Symbol, Symbols};
 /// Pass 1: every label (spec §3.4: names and elements may be used before their declaration
 /// line), those a `~generate` directive creates included (§4), with duplicates reported.
 /// A `~generate` directive is read here and kept on its item for pass 2.
+///
+/// In a 3-D script (`space`), labels name what the 3-D keywords make, and the structures and
+/// adders record the labels they create ([`Pass1`]); `~generate` is a 1-D directive, reported
+/// in pass 2.
 pub(super) fn declare_labels<'a>(
     items: &mut [Item],
     all: &[Token<'a>],
     diags: &mut Diags,
+    mut space: Option<&mut Pass1<'_>>,
 ) -> Symbols<'a> {
     let mut symbols = Symbols::with_capacity(items.len());
     let mut budget = MAX_GENERATED_ELEMENTS;
     for item in items.iter_mut() {
+        if item.directive && space.is_some() {
+            continue;
+        }
         if item.directive {
             if let Some(name) = item.broken_generator.take() {
                 symbols.insert_broken_generator(name);
@@ -51,19 +60,24 @@ pub(super) fn declare_labels<'a>(
             ));
             continue;
         }
-        let kind = tokens
-            .get(1)
-            .filter(|t| t.kind != TokKind::Bracket)
-            .and_then(|t| shape_of(t.text))
-            .map(sym_kind)
-            .unwrap_or(SymKind::Unknown);
+        let keyword = tokens.get(1).filter(|t| t.kind != TokKind::Bracket);
+        let kind = match (&space, keyword) {
+            (Some(_), Some(k)) => Pass1::kind_of(k.text),
+            (None, Some(k)) => shape_of(k.text).map_or(SymKind::Unknown, sym_kind),
+            (_, None) => SymKind::Unknown,
+        };
         let symbol = Symbol {
             kind,
             line: item.line,
             col: first.col,
             generated: false,
         };
-        if let Err((label, prev)) = symbols.declare(label, symbol) {
+        let declared = symbols.declare(label, symbol);
+        if let (Ok(()), Some(pass), Some(k)) = (&declared, space.as_deref_mut(), keyword) {
+            let args = tokens.get(2..).unwrap_or(&[]);
+            pass.declared(&mut symbols, label, k.text, args, (item.line, first.col));
+        }
+        if let Err((label, prev)) = declared {
             let message = if prev.generated {
                 format!(
                     "duplicate label `@{label}`: the `~generate` at line {} column {} \

@@ -57,6 +57,7 @@ impl Builder<'_> {
             symbols: self.symbols,
             line: at.line,
             label: at.label,
+            auto: self.auto,
         };
         parse_expression(t.text, t.inner_col(), &cx, &mut self.diags)
     }
@@ -72,6 +73,7 @@ impl Builder<'_> {
             symbols: self.symbols,
             line: at.line,
             label: at.label,
+            auto: self.auto,
         };
         parse_expression(text, col_plus(t.inner_col(), offset), &cx, &mut self.diags)
     }
