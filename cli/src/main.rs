@@ -20,9 +20,8 @@ mod report;
 
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use ressort_engine::{
-    compile, parse_bytes, CompileOptions, Engine, InputUse, ModelSpec, ScaleClass,
-};
+use ressort_engine::lang::{folder_files, parse_bytes_with_files};
+use ressort_engine::{compile, CompileOptions, Engine, InputUse, ModelSpec, ScaleClass};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -202,7 +201,8 @@ fn main() -> ExitCode {
 fn load(path: &Path) -> Result<ModelSpec, Failure> {
     let bytes =
         std::fs::read(path).map_err(|e| usage(format!("cannot read {}: {e}", path.display())))?;
-    let parsed = parse_bytes(&bytes);
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let parsed = parse_bytes_with_files(&bytes, &folder_files(folder));
     for d in &parsed.diagnostics {
         eprintln!("{}:{d}", path.display());
     }
@@ -563,7 +563,8 @@ fn bench(a: &BenchArgs) -> Result<(), Failure> {
     let bytes = std::fs::read(&a.model)
         .map_err(|e| usage(format!("cannot read {}: {e}", a.model.display())))?;
     let start = Instant::now();
-    let parsed = parse_bytes(&bytes);
+    let folder = a.model.parent().unwrap_or(Path::new("."));
+    let parsed = parse_bytes_with_files(&bytes, &folder_files(folder));
     let spec = match parsed.spec {
         Some(spec) => spec,
         None => {

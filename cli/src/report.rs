@@ -29,10 +29,21 @@ pub fn print_compile_error(path: &Path, e: &CompileError) {
     eprintln!("{}: error: {label}{}", location(path, e.span), e.kind);
 }
 
-/// The span of the element that owns a label (`s` for `s[12]`).
+/// The span of the element that owns a label (`s` for `s[12]`; a 3-D structure's own label).
 fn span_of(spec: &ModelSpec, label: &str) -> Span {
     let owner = label.split('[').next().unwrap_or(label);
-    spec.element(owner).map(|e| e.span).unwrap_or_default()
+    match &spec.space {
+        Some(space) => space.element(owner).map(|e| e.span).unwrap_or_default(),
+        None => spec.element(owner).map(|e| e.span).unwrap_or_default(),
+    }
+}
+
+/// The label and span of element `i` (an index into the 3-D elements of a 3-D model).
+fn element_at(spec: &ModelSpec, i: usize) -> Option<(String, Span)> {
+    match &spec.space {
+        Some(space) => space.elements.get(i).map(|e| (e.label.to_string(), e.span)),
+        None => spec.elements.get(i).map(|e| (e.label.to_string(), e.span)),
+    }
 }
 
 /// Stability warnings on stderr, at the line of the element involved.
@@ -58,9 +69,8 @@ pub fn print_stability_warnings(
             | StabilityWarning::NegativeCubic { .. }
             | StabilityWarning::WeakBound { .. } => {
                 // A link: at the interaction's own line, named by its label.
-                let e = w.element().and_then(|i| spec.elements.get(i));
-                if let Some(e) = e {
-                    eprintln!("{}: warning: @{}: {w}", location(path, e.span), e.label);
+                if let Some((label, span)) = w.element().and_then(|i| element_at(spec, i)) {
+                    eprintln!("{}: warning: @{label}: {w}", location(path, span));
                     continue;
                 }
                 Span::default()
@@ -87,9 +97,13 @@ pub fn summary(path: &Path, spec: &ModelSpec, engine: &Engine, report: &Stabilit
     let avatars = count(&|k| matches!(k, PointKind::Avatar));
     let grounds = count(&|k| matches!(k, PointKind::Ground))
         + count(&|k| matches!(k, PointKind::MacroNode { fixed: true }));
+    let (space, nodes_word) = match engine.is_3d() {
+        true => ("in 3-D: x, y and z; ", "structure nodes"),
+        false => ("", "macro nodes"),
+    };
     let _ = writeln!(
         s,
-        "points        {} ({} single, {} macro nodes, {} avatars; {} fixed)",
+        "points        {} ({space}{} single, {} {nodes_word}, {} avatars; {} fixed)",
         info.num_points,
         info.num_points - nodes - avatars,
         nodes,

@@ -31,6 +31,7 @@ mod errors;
 mod kinds;
 mod labels;
 mod points;
+mod space;
 
 pub use errors::{CompileError, CompileErrorKind, CompileErrors};
 
@@ -79,6 +80,10 @@ pub fn compile(spec: &ModelSpec, options: &CompileOptions) -> Result<Engine, Com
     let mut cx = Cx::new(spec);
     let rate = cx.rate(options);
     let params = cx.resolve_labels();
+    // A 3-D model (`~dim 3`) has passes of its own (3-D spec).
+    if spec.space.is_some() {
+        return cx.compile_space(options, rate, params);
+    }
     let numbering = cx.number_points();
     let mut kinds = cx.group_into_kinds(&params, &numbering);
     kinds.links.order_into_bands();

@@ -4,10 +4,17 @@
 //! the parser reports (in `ressort check`'s `model.mdl:LINE:COL: …` form); and every diagnostic
 //! code is documented.
 
-use ressort_engine::lang::{parse, print};
+use ressort_engine::lang::{folder_files, parse_with_files, print};
 use ressort_engine::DiagnosticCode;
 
 const GUIDE: &str = include_str!("../../docs/LANGUAGE.md");
+
+/// A block parsed as `ressort check` would parse a script in `models/`: a 3-D example's
+/// `objMesh` reads its file there.
+fn parse(text: &str) -> ressort_engine::lang::Parsed {
+    let models = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../models"));
+    parse_with_files(text, &folder_files(models))
+}
 
 /// A fenced block: its tag, its text and the line of the opening fence (1-based).
 struct Block {
@@ -53,7 +60,20 @@ fn valid_examples_parse_cleanly_and_round_trip() {
             p.diagnostics
         );
         let spec = p.spec.unwrap();
-        assert_eq!(parse(&print(&spec)).spec, Some(spec));
+        assert_eq!(parse(&print(&spec)).spec, Some(spec.clone()));
+        // A 3-D example also builds and plays (struck on every input) without tripping.
+        if spec.space.is_some() {
+            let mut e = ressort_engine::compile(&spec, &ressort_engine::CompileOptions::at(48000.0))
+                .unwrap_or_else(|e| panic!("LANGUAGE.md line {}: {e}", b.line));
+            let (n_in, n_out, frames) = (e.info().num_inputs(), e.info().num_outputs(), 4800);
+            let mut input = vec![0.0; n_in * frames];
+            for c in 0..n_in {
+                input[c * frames] = 0.001;
+            }
+            let mut out = vec![0.0; n_out * frames];
+            let report = e.process(frames, &input, &mut out);
+            assert!(!report.tripped, "LANGUAGE.md line {}: {:?}", b.line, e.guard_event());
+        }
         count += 1;
     }
     assert!(count >= 30, "only {count} examples");

@@ -89,18 +89,40 @@ pub(crate) fn kind_moves(kind: PointKind) -> bool {
 }
 
 /// The material points an endpoint stands for, with weights: the point itself with weight 1,
-/// or the macro nodes of a connection point with their interpolation weights (spec §2.8).
+/// or the nodes of a connection point with their interpolation weights (spec §2.8; a 3-D
+/// model's, 3-D spec §2.6).
 pub(crate) fn endpoint_nodes(e: &Engine, p: u32) -> impl Iterator<Item = (usize, f64)> + '_ {
     let p = p as usize;
     let n = e.model.info.num_points;
-    let proxy = p
-        .checked_sub(e.proxies.base)
-        .filter(|&i| p >= n && i < e.proxies.len());
-    let (nodes, weights): ([u32; 4], [f64; 4]) = match proxy {
-        Some(i) => (e.proxies.nodes[i], e.proxies.weights[i]),
-        None if p < n => ([p as u32, 0, 0, 0], [1.0, 0.0, 0.0, 0.0]),
-        None => ([0; 4], [0.0; 4]),
-    };
+    let mut nodes = [0u32; 8];
+    let mut weights = [0.0; 8];
+    match &e.space {
+        Some(space) => {
+            for (k, (node, w)) in crate::analysis::space::endpoint_nodes(space, n, p as u32)
+                .into_iter()
+                .enumerate()
+            {
+                nodes[k] = node as u32;
+                weights[k] = w;
+            }
+        }
+        None => {
+            let proxy = p
+                .checked_sub(e.proxies.base)
+                .filter(|&i| p >= n && i < e.proxies.len());
+            match proxy {
+                Some(i) => {
+                    nodes[..4].copy_from_slice(&e.proxies.nodes[i]);
+                    weights[..4].copy_from_slice(&e.proxies.weights[i]);
+                }
+                None if p < n => {
+                    nodes[0] = p as u32;
+                    weights[0] = 1.0;
+                }
+                None => {}
+            }
+        }
+    }
     nodes
         .into_iter()
         .zip(weights)
@@ -111,6 +133,10 @@ pub(crate) fn endpoint_nodes(e: &Engine, p: u32) -> impl Iterator<Item = (usize,
 impl Network {
     /// Walks the compiled model once (spec §5.2 and §5.5).
     pub(crate) fn walk(e: &Engine, valuation: Valuation<'_>) -> Network {
+        if e.space.is_some() {
+            // A 3-D model's stability network (its modes come from its own system).
+            return crate::analysis::space::bound_network(e);
+        }
         let info = &e.model.info;
         let n = info.num_points;
         let args = &e.args;

@@ -143,6 +143,7 @@ impl<'a> Cx<'a> {
             arch,
             native: None,
             native_fits: false,
+            space: None,
         };
         engine.reset();
         if options.jit {
@@ -197,7 +198,7 @@ impl<'a> Cx<'a> {
 }
 
 /// The scale factor of every argument class at `sr` (spec §1.7).
-fn class_scales(mode: SampleRateMode, sr: f64) -> [f64; NUM_ARG_CLASSES] {
+pub(super) fn class_scales(mode: SampleRateMode, sr: f64) -> [f64; NUM_ARG_CLASSES] {
     let k = ScaleClass::Stiffness.factor(mode, sr);
     let z = ScaleClass::Damping.factor(mode, sr);
     let mut s = [1.0; NUM_ARG_CLASSES];

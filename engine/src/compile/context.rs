@@ -107,12 +107,19 @@ impl<'a> Cx<'a> {
     }
 
     pub fn error(&mut self, element: Option<usize>, kind: CompileErrorKind) {
-        let (label, span) = match element {
-            Some(i) => (
+        let (label, span) = match (element, &self.spec.space) {
+            // A 3-D model's elements are its space's.
+            (Some(i), Some(space)) => space
+                .elements
+                .get(i)
+                .map_or((String::new(), Span::default()), |e| {
+                    (e.label.to_string(), e.span)
+                }),
+            (Some(i), None) => (
                 self.spec.elements[i].label.to_string(),
                 self.spec.elements[i].span,
             ),
-            None => (String::new(), Span::default()),
+            (None, _) => (String::new(), Span::default()),
         };
         self.errors.push(CompileError { kind, label, span });
     }

@@ -50,6 +50,9 @@ pub enum CompileErrorKind {
     InvalidChannel,
     /// A constant argument outside its domain (e.g. a mass that is not > 0).
     InvalidValue { what: &'static str, value: f64 },
+    /// A 3-D structure that cannot be generated (3-D spec §4), or an element a 3-D model
+    /// cannot build, with why.
+    Structure(String),
 }
 
 /// A compile error: what, on which element, and where in the script.
@@ -114,6 +117,7 @@ impl fmt::Display for CompileErrorKind {
             ),
             InvalidChannel => write!(f, "channel numbers start at 1"),
             InvalidValue { what, value } => write!(f, "{what}, found {value}"),
+            Structure(why) => write!(f, "{why}"),
         }
     }
 }

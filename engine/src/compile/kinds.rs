@@ -228,7 +228,7 @@ fn law_row(law: &Law) -> (LawKind, LawArgs<'_>) {
 }
 
 /// The text of an endpoint, for metadata (`@h`, `[@s 0.3]`).
-fn describe_endpoint(ep: &Endpoint) -> String {
+pub(super) fn describe_endpoint(ep: &Endpoint) -> String {
     match ep {
         Endpoint::Label(l) => format!("@{l}"),
         Endpoint::Line { target, alpha } => format!("[@{target} {}]", bracket_coord(alpha)),

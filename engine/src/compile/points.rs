@@ -82,6 +82,7 @@ impl Cx<'_> {
                     label: e.label.clone(),
                     keyword: e.kind.keyword(),
                     mesh_width: width,
+                    sizes: Vec::new(),
                 });
                 owner_element.push(i);
                 self.element_point[i] = Some(points.len() as u32);

@@ -255,25 +255,28 @@ pub fn resolve(
         }
         // The law the avatar acts through, for the defaults and the reference pitch.
         let avatar = format!("in{}", d.input);
-        let law = spec.elements.iter().find_map(|e| match &e.kind {
-            ElementKind::Interaction { law, a, b } => {
-                let (me, other) = if matches!(a, Endpoint::Label(l) if **l == avatar) {
-                    (a, b)
-                } else if matches!(b, Endpoint::Label(l) if **l == avatar) {
-                    (b, a)
-                } else {
-                    return None;
-                };
-                let _ = me;
-                let scale = match (d.kind, law.kind()) {
-                    (ExciterKind::Bow, LawKind::Bow) => law.arg("Vscale"),
-                    (ExciterKind::Pluck, LawKind::Pluck) => law.arg("Pscale"),
-                    _ => None,
-                }?;
-                Some((scale.eval(&lookup), other.clone()))
-            }
-            _ => None,
-        });
+        let law = match &spec.space {
+            Some(space) => space_law(space, &avatar, d.kind, &lookup),
+            None => spec.elements.iter().find_map(|e| match &e.kind {
+                ElementKind::Interaction { law, a, b } => {
+                    let (me, other) = if matches!(a, Endpoint::Label(l) if **l == avatar) {
+                        (a, b)
+                    } else if matches!(b, Endpoint::Label(l) if **l == avatar) {
+                        (b, a)
+                    } else {
+                        return None;
+                    };
+                    let _ = me;
+                    let scale = match (d.kind, law.kind()) {
+                        (ExciterKind::Bow, LawKind::Bow) => law.arg("Vscale"),
+                        (ExciterKind::Pluck, LawKind::Pluck) => law.arg("Pscale"),
+                        _ => None,
+                    }?;
+                    Some((scale.eval(&lookup), other.clone()))
+                }
+                _ => None,
+            }),
+        };
         let ms = d.time_ms.unwrap_or(if d.kind == ExciterKind::Pluck {
             DEFAULT_SWEEP_MS
         } else {
@@ -351,4 +354,39 @@ pub fn resolve(
     } else {
         Err(Rejected(errors))
     }
+}
+
+/// The law a 3-D avatar `avatar` acts through for an exciter of `kind` (3-D spec §2.5): the
+/// bow's Vscale or the plectrum's Pscale, and the endpoint it acts on.
+fn space_law(
+    space: &crate::spec::space::SpaceSpec,
+    avatar: &str,
+    kind: ExciterKind,
+    lookup: &impl Fn(&str) -> Option<f64>,
+) -> Option<(f64, Endpoint)> {
+    use crate::laws::space::SpaceLawKind as K;
+    space.elements.iter().find_map(|e| match &e.kind {
+        crate::spec::space::SpaceKind::Interaction {
+            law,
+            args,
+            a,
+            b: Some(b),
+        } => {
+            let other = if matches!(a, Endpoint::Label(l) if **l == *avatar) {
+                b
+            } else if matches!(b, Endpoint::Label(l) if **l == *avatar) {
+                a
+            } else {
+                return None;
+            };
+            let column = match (kind, law) {
+                (ExciterKind::Bow, K::Bow | K::BowDir) => "Vscale",
+                (ExciterKind::Pluck, K::Pluck | K::PluckDir) => "Pscale",
+                _ => return None,
+            };
+            let slot = law.row().slot_of(column)?;
+            Some((args.get(slot)?.eval(lookup), other.clone()))
+        }
+        _ => None,
+    })
 }

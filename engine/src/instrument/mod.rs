@@ -31,6 +31,7 @@ pub mod host;
 pub mod level;
 mod load;
 pub mod macros;
+pub mod meshes;
 pub mod output;
 pub mod pitch;
 pub mod prepare;

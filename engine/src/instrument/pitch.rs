@@ -44,13 +44,41 @@ pub(crate) fn musical_reference_pitch(
     if let Some(target) = contact {
         let channel = roles.len() as u32 + 1;
         let mut probe = spec.clone();
-        probe.elements.push(Element {
-            label: crate::spec::Label::new(format!("in{channel}")),
-            kind: ElementKind::FrcInput { channel, target },
-            buffers: Vec::new(),
-            tag_xy: None,
-            span: Span::default(),
-        });
+        let label = crate::spec::Label::new(format!("in{channel}"));
+        match &mut probe.space {
+            // A 3-D probe pushes along the line the exciter's avatar moves on.
+            Some(space) => {
+                let avatar = exciters
+                    .iter()
+                    .find(|x| x.contact.is_some())
+                    .map(|x| format!("in{}", x.input + 1));
+                let dir = space.elements.iter().find_map(|e| match &e.kind {
+                    crate::spec::space::SpaceKind::PosInput { dir, .. }
+                        if Some(e.label.as_str()) == avatar.as_deref() =>
+                    {
+                        dir.clone()
+                    }
+                    _ => None,
+                });
+                space.elements.push(crate::spec::space::SpaceElement {
+                    label,
+                    kind: crate::spec::space::SpaceKind::FrcInput {
+                        channel,
+                        target,
+                        dir,
+                    },
+                    buffers: Vec::new(),
+                    span: Span::default(),
+                });
+            }
+            None => probe.elements.push(Element {
+                label,
+                kind: ElementKind::FrcInput { channel, target },
+                buffers: Vec::new(),
+                tag_xy: None,
+                span: Span::default(),
+            }),
+        }
         let mut options = CompileOptions::at(sample_rate);
         options.jit = false;
         if let Ok(mut e) = compile(&probe, &options) {

@@ -117,7 +117,7 @@ pub struct Prepared {
 /// Parses a script and turns every error into a `LINE:COL: error: …` line. Warnings are kept
 /// too, after the errors, when the script is accepted.
 pub fn parse_script(text: &str) -> Result<(ModelSpec, HostSettings, Vec<String>), Rejected> {
-    let parsed = parse(text);
+    let parsed = crate::lang::parse_with_files(text, &super::meshes::shipped);
     let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
     if !errors.is_empty() {
         return Err(Rejected(errors));
@@ -130,7 +130,11 @@ pub fn parse_script(text: &str) -> Result<(ModelSpec, HostSettings, Vec<String>)
     };
     // The language allows an empty model; an instrument has nothing to play in one, and a
     // cleared editor or an empty file must not silence the running model.
-    if spec.elements.is_empty() {
+    let elements = spec
+        .space
+        .as_ref()
+        .map_or(spec.elements.len(), |s| s.elements.len());
+    if elements == 0 {
         return Err(Rejected(vec![
             "1:1: error: the script is empty: it defines no element to play (write a model, \
              see docs/LANGUAGE.md, or choose a preset)"
@@ -430,6 +434,11 @@ pub fn input_rests(engine: &Engine) -> Vec<f64> {
                 .map(|i| engine.positions()[i])
                 .unwrap_or(0.0),
             _ => 0.0,
+        })
+        .enumerate()
+        .map(|(c, rest)| match engine.is_3d() {
+            true => engine.avatar_rest(c).unwrap_or(0.0),
+            false => rest,
         })
         .collect()
 }

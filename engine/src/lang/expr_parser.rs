@@ -375,7 +375,7 @@ impl ExprParser<'_, '_> {
                     DiagnosticCode::UndefinedName,
                     col,
                     "`auto` is the endpoints' distance at stage 0: it stands only in a rest \
-                     length L, a contact distance D or a bubble's radius R (3-D spec §1.7)"
+                     length L, a contact distance D or a bubble's radius R"
                         .to_string(),
                 );
                 return;

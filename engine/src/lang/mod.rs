@@ -55,6 +55,15 @@ pub use printer::print;
 
 use crate::spec::ModelSpec;
 
+/// The files beside a script read from `folder`, for [`parse_with_files`]: `objMesh
+/// 'bell.obj'` reads `folder/bell.obj` (3-D spec §4.6: paths are relative to the script's
+/// folder). An error is the reason, which the diagnostic shows at the path.
+pub fn folder_files(folder: &std::path::Path) -> impl Fn(&str) -> Result<String, String> + '_ {
+    move |path: &str| {
+        std::fs::read_to_string(folder.join(path)).map_err(|e| format!("cannot read {path}: {e}"))
+    }
+}
+
 /// The result of parsing a script.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Parsed {

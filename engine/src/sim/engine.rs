@@ -69,7 +69,7 @@ pub const POINT_LIMIT_FACTOR: f64 = 1.0e8;
 /// every copy behind an `Arc`) and this copy's state. Built by [`crate::compile`]. A clone is a
 /// new voice: it copies the state and shares the model.
 ///
-/// 3,720 bytes on x86-64 (checked below; 2,376 of them are the vector headers of the nine
+/// 3,728 bytes on x86-64 (checked below; 2,376 of them are the vector headers of the nine
 /// law groups), and on the heap: 24 bytes per point (x, x̃, F), 8 per link of the longest
 /// chain, 8 per argument slot, 47 per single mass (a, b, 1/M, g, three flags and a run), 16
 /// per node of the largest macro (its scratch), 12 per link (endpoints and element) and 2 per
@@ -122,6 +122,9 @@ pub struct Engine {
     /// Whether `native` runs the model as it stands ([`crate::sim::jit::NativeCode::fits`]):
     /// updated with the coefficients at every control change.
     pub(crate) native_fits: bool,
+    /// A 3-D model's x and y axes and everything but its z axis, which is `points`
+    /// ([`crate::sim::space`]); `None` for a 1-D model, whose kinds are the fields above.
+    pub(crate) space: Option<Box<crate::sim::space::Space>>,
 }
 
 /// One block of [`Engine::process`] as a pulp operation: `with_simd` is inlined into the
@@ -339,6 +342,73 @@ impl Engine {
         &self.points.x
     }
 
+    /// Whether the model is three-dimensional (`~dim 3`).
+    pub fn is_3d(&self) -> bool {
+        self.space.is_some()
+    }
+
+    /// The positions along axis `c` (0 x, 1 y, 2 z) of every point, in the order of
+    /// [`Engine::positions`]: a 1-D model's positions are its z axis, its x and y are empty.
+    pub fn axis(&self, c: usize) -> &[f64] {
+        match (&self.space, c) {
+            (Some(s), 0) => &s.ax.x,
+            (Some(s), 1) => &s.ay.x,
+            (_, 2) => &self.points.x,
+            _ => &[],
+        }
+    }
+
+    /// How much the model moved: the largest |x − x̃| of any point on any axis, and of
+    /// |x − last| on the z axis (`last` is updated to x; the positions' length). A voice
+    /// bank frees a voice whose level stays below its threshold.
+    pub fn motion_level(&self, last: &mut [f64]) -> f64 {
+        let mut level: f64 = 0.0;
+        let p = &self.points;
+        for ((x, xp), last) in p.x.iter().zip(&p.xp).zip(last.iter_mut()) {
+            level = level.max((x - xp).abs()).max((x - *last).abs());
+            *last = *x;
+        }
+        if let Some(space) = &self.space {
+            for axis in [&space.ax, &space.ay] {
+                for (x, xp) in axis.x.iter().zip(&axis.xp) {
+                    level = level.max((x - xp).abs());
+                }
+            }
+        }
+        level
+    }
+
+    /// What input channel `channel` (0-based) holds when nothing feeds it, for a position
+    /// input: its avatar's declared position along its direction (3-D spec §3.1: the channel
+    /// is the coordinate along â, P·â; an XYZ avatar's channels its coordinates). `None` when
+    /// no avatar reads it.
+    pub fn avatar_rest(&self, channel: usize) -> Option<f64> {
+        let space = self.space.as_ref()?;
+        let m = &space.model;
+        for av in &m.avatars {
+            match *av {
+                crate::sim::space::Avatar::Line {
+                    channel: c, perp, ..
+                } if c as usize == channel => {
+                    let (slots, dir) = m.directions.perp[perp as usize];
+                    let at = slots.map(|k| self.args[k as usize]);
+                    let d = space.directions.units[dir as usize];
+                    return Some((at[0] * d[0] + at[1] * d[1]) + at[2] * d[2]);
+                }
+                crate::sim::space::Avatar::Xyz { point, channel: c } => {
+                    let c = c as usize;
+                    if (c..c + 3).contains(&channel) {
+                        let axis = channel - c;
+                        let init = self.axis(axis).get(point as usize).copied();
+                        return init;
+                    }
+                }
+                _ => {}
+            }
+        }
+        None
+    }
+
     /// Delayed positions x̃, in the order of [`Engine::positions`].
     pub fn delayed_positions(&self) -> &[f64] {
         &self.points.xp
@@ -357,6 +427,18 @@ impl Engine {
     /// and the motion counter reset. Parameters keep their values. Realtime-safe.
     pub fn reset(&mut self) {
         self.refresh_control();
+        if let Some(space) = &mut self.space {
+            let (program, params, stack) = (&self.model.program, &self.params, &mut self.stack);
+            space.reset(&mut self.points, &self.args, |e| {
+                program.eval(e, params, stack)
+            });
+            self.flush_all();
+            self.guard = None;
+            self.rest = Rest::Moving;
+            self.samples_since_reset = 0;
+            self.motion_counter = 0;
+            return;
+        }
         self.points.f.fill(0.0);
         self.macros.reset();
         for run in &self.model.init_runs {
@@ -432,6 +514,9 @@ impl Engine {
             &mut self.args,
         );
         self.refresh_audio_args(&scale);
+        if let Some(space) = &mut self.space {
+            space.derive(&self.args);
+        }
         match changed {
             Changed::All => {
                 for i in 0..self.singles.len() {
@@ -536,7 +621,7 @@ impl Engine {
                 // Still after a silent sample: one more decides whether this is a fixed point.
                 simulated = block(self, outputs, 0, 1);
                 start = 1;
-                self.rest = if self.guard.is_none() && rest::stationary(&self.points) {
+                self.rest = if self.guard.is_none() && self.stationary() {
                     Rest::Fixed
                 } else {
                     Rest::Moving
@@ -547,16 +632,21 @@ impl Engine {
                     self.hold(start, frames, outputs, out_channels)
                 } else {
                     let n = block(self, outputs, start, frames);
-                    if self.guard.is_none() && rest::stationary(&self.points) && quiet(self) {
+                    if self.guard.is_none() && self.stationary() && quiet(self) {
                         self.rest = Rest::Still;
                     }
                     n
                 };
             }
             if self.guard.is_none() {
-                if let Some((kind, point)) =
-                    guard::scan_positions(&self.points.x, self.point_limit())
-                {
+                let limit = self.point_limit();
+                let mut bad = guard::scan_positions(&self.points.x, limit);
+                if let Some(space) = &self.space {
+                    bad = bad
+                        .or_else(|| guard::scan_positions(&space.ax.x, limit))
+                        .or_else(|| guard::scan_positions(&space.ay.x, limit));
+                }
+                if let Some((kind, point)) = bad {
                     self.trip(kind, Some(point), None);
                 }
             }
@@ -666,15 +756,38 @@ impl Engine {
         }
         self.samples_since_reset += 1;
         if self.samples_since_reset.is_multiple_of(FLUSH_INTERVAL) {
-            flush_tiny(&mut self.points);
+            self.flush_all();
         }
         false
+    }
+
+    /// The periodic flush on every axis.
+    #[inline(always)]
+    fn flush_all(&mut self) {
+        flush_tiny(&mut self.points);
+        if let Some(space) = &mut self.space {
+            for axis in space.planar_axes() {
+                flush_tiny(axis);
+            }
+        }
+    }
+
+    /// Whether every point of every axis stands still ([`rest::stationary`]).
+    fn stationary(&self) -> bool {
+        rest::stationary(&self.points)
+            && self
+                .space
+                .as_ref()
+                .is_none_or(|s| rest::stationary(&s.ax) && rest::stationary(&s.ay))
     }
 
     /// One sample: stages 1 to 5 of spec §1.5 (stage 6 is `write_outputs`, stage 7 in
     /// `sample`).
     #[inline(always)]
     fn step(&mut self, input: &impl Fn(u32) -> f64, scale: &[f64; NUM_ARG_CLASSES]) {
+        if self.space.is_some() {
+            return self.step_space(input, scale);
+        }
         // Stage 1 a: avatars.
         for r in &self.model.avatars {
             let k = r.index as usize;
@@ -711,6 +824,32 @@ impl Engine {
         }
         // Stage 5: connection-point force spreading.
         self.proxies.spread_forces(&mut self.points);
+    }
+
+    /// One sample of a 3-D model: stages 1 to 5 of 3-D spec §1.5.
+    #[inline(always)]
+    fn step_space(&mut self, input: &impl Fn(u32) -> f64, scale: &[f64; NUM_ARG_CLASSES]) {
+        let Some(space) = &mut self.space else {
+            return;
+        };
+        // Stage 1 a: avatars.
+        space.avatars(&mut self.points, input);
+        // Stage 1 b: audio-rate parameters and what they move.
+        if !self.model.audio_params.is_empty() {
+            for (r, d) in self.model.audio_params.iter().zip(&self.audio_defaults) {
+                self.params[r.index as usize] = d + input(r.channel);
+            }
+            for b in &self.model.audio_bindings {
+                self.args[b.slot as usize] =
+                    self.model
+                        .program
+                        .eval(b.expr, &self.params, &mut self.stack)
+                        * scale[b.class as usize];
+            }
+            space.derive_audio(&self.args);
+        }
+        // Stages 2 to 5.
+        space.step(&mut self.points, &self.args, input);
     }
 
     /// Samples `start..frames` of a block at a fixed point ([`Rest::Fixed`], `rest.rs`): the
@@ -788,6 +927,12 @@ impl Engine {
                 }
             }
         };
+        if let Some(space) = &self.space {
+            for o in &space.model.outputs {
+                put(o.channel(), space.output(o, &self.points));
+            }
+            return bad;
+        }
         for r in &self.model.pos_outputs {
             put(r.channel, self.points.x[r.index as usize]);
         }
@@ -802,4 +947,4 @@ impl Engine {
 
 /// The size written in [`Engine`]'s doc comment.
 #[cfg(target_arch = "x86_64")]
-const _: () = assert!(std::mem::size_of::<Engine>() == 3720);
+const _: () = assert!(std::mem::size_of::<Engine>() == 3728);

@@ -36,6 +36,9 @@ pub struct OwnerInfo {
     pub keyword: &'static str,
     /// For meshes, the width W (nodes are i·W + j); 0 for everything else.
     pub mesh_width: u32,
+    /// A 3-D structure's sizes (3-D spec §4), whose nodes are labelled `s_m12`, `me_m3_4`,
+    /// `c_m1_0_2`; empty for everything else.
+    pub sizes: Vec<u32>,
 }
 
 /// A declared parameter.
@@ -134,6 +137,15 @@ impl ModelInfo {
 
     fn point_label_of(&self, p: &PointInfo) -> String {
         let owner = &self.owners[p.owner as usize];
+        let structure = crate::spec::space::StructureKind::from_keyword(owner.keyword);
+        if let (Some(kind), PointKind::MacroNode { .. }) = (structure, p.kind) {
+            return crate::spec::space::structures::node_label(
+                &owner.label,
+                kind,
+                &owner.sizes,
+                p.node as usize,
+            );
+        }
         match p.kind {
             PointKind::MacroNode { .. } if owner.mesh_width > 0 => format!(
                 "{}[{},{}]",

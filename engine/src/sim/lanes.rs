@@ -121,7 +121,9 @@ impl LaneEngine {
     /// Whether a model runs in lanes: no audio-rate parameters (they re-derive arguments
     /// every sample), and at most [`MAX_LANE_POINTS`] points.
     pub fn supports(engine: &Engine) -> bool {
-        engine.model.audio_params.is_empty()
+        // A 3-D model's voices run as engines (its lanes are not written yet).
+        engine.space.is_none()
+            && engine.model.audio_params.is_empty()
             && engine.model.audio_bindings.is_empty()
             && engine.points.x.len() <= MAX_LANE_POINTS
     }

@@ -29,3 +29,4 @@ pub mod lanes;
 pub mod motion;
 pub(crate) mod native;
 pub(crate) mod rest;
+pub(crate) mod space;

@@ -34,9 +34,9 @@
 //! proportional case, c = φ_o·φ_i / (r − r̄), so the gain is |φ_o·φ_i| / Im r.
 
 mod limit;
-mod solve;
+pub(crate) mod solve;
 mod sparse;
-mod system;
+pub(crate) mod system;
 
 pub use limit::{ExactStability, StiffnessLimit};
 
@@ -227,6 +227,9 @@ impl Engine {
     /// A force input on a point with contacts open at rest (a hammer) also drives what those
     /// contacts strike, with weight 1: its gains are those of the blow it delivers.
     pub fn modes(&mut self, count: Option<usize>) -> ModalAnalysis {
+        if self.space.is_some() {
+            return self.modes_in_space(count);
+        }
         let rest = self.rest_positions();
         let net = Network::walk(self, Valuation::Rest(&rest));
         let sys = System::assemble(self, &net, true);
@@ -234,6 +237,23 @@ impl Engine {
         // A failure inside a linear-algebra crate ends this analysis, not the host.
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             solve::modes(&sys, num_points, sample_rate, count)
+        }))
+        .unwrap_or_else(|_| {
+            let mut empty = solve::unsolved(&sys, sample_rate);
+            empty.skipped = Some("the eigensolver failed on this model".into());
+            empty
+        })
+    }
+
+    /// The modes of a 3-D model (3-D spec §6): linearised at its static equilibrium, three
+    /// degrees of freedom per point ([`Mode::shape`] has x, y and z per point).
+    fn modes_in_space(&mut self, count: Option<usize>) -> ModalAnalysis {
+        self.apply_pending_changes();
+        let eq = crate::analysis::space::equilibrium::equilibrium(self);
+        let sys = crate::analysis::space::system::assemble(self, &eq.x, true);
+        let (slots, sample_rate) = (3 * self.model.info.num_points, self.sample_rate_hz());
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            solve::modes(&sys, slots, sample_rate, count)
         }))
         .unwrap_or_else(|_| {
             let mut empty = solve::unsolved(&sys, sample_rate);

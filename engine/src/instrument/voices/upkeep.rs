@@ -37,15 +37,7 @@ impl VoiceBank {
                 continue;
             }
             let level = match &self.copies {
-                Copies::Engines(e) => {
-                    let (x, xp) = (e[i].positions(), e[i].delayed_positions());
-                    let mut level: f64 = 0.0;
-                    for ((x, xp), last) in x.iter().zip(xp).zip(v.last.iter_mut()) {
-                        level = level.max((x - xp).abs()).max((x - *last).abs());
-                        *last = *x;
-                    }
-                    level
-                }
+                Copies::Engines(e) => e[i].motion_level(&mut v.last),
                 Copies::Lanes(_) => levels[i % LANES],
             };
             v.level = level;

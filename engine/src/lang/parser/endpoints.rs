@@ -155,7 +155,7 @@ impl Builder<'_> {
             }
             Some(SymKind::Macro { dims }) if usize::from(dims) != found => {
                 let what = match (dims, self.space.is_some()) {
-                    (0, _) => "an icosphere's or a mesh file's nodes are addressed by label,                                e.g. `@b_m3` (3-D spec §2.6); it takes no coordinate",
+                    (0, _) => "an icosphere's or a mesh file's nodes are addressed by label,                                e.g. `@b_m3`; it takes no coordinate",
                     (3, _) => "a lattice takes 3 coordinates [@c u v w]",
                     (2, true) => "a membrane takes 2 coordinates [@me u w]",
                     (1, true) => "a string or ring takes 1 coordinate [@s α]",

@@ -36,7 +36,7 @@ impl Builder<'_> {
                         e.span.col,
                         format!(
                             "input channel {channel} is taken by `@{by}` at line {line}, an XYZ \
-                             element that reads channels N, N+1 and N+2 (3-D spec §3.1)"
+                             element that reads channels N, N+1 and N+2"
                         ),
                     )
                     .with_label(Some(&e.label)),
@@ -220,7 +220,7 @@ fn lints(
                         format!(
                             "the `{}` is anchored but its links are not shorter than their \
                              spacing (L = auto or more): it has no transverse stiffness, so no \
-                             small-signal pitch (3-D spec §4.1, §5.6); pre-tension it with L < \
+                             small-signal pitch; pre-tension it with L < \
                              spacing, e.g. `[0.9*auto]`",
                             s.kind.keyword()
                         ),

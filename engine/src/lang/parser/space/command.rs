@@ -78,7 +78,7 @@ impl Builder<'_> {
                     if k.row().columns.iter().any(|c| c.shape == ColShape::Length) {
                         m.push_str(
                             "; in 3-D an elastic link takes its rest length (or contact \
-                             distance) too, `auto` for the distance at rest (3-D spec §1.7)",
+                             distance) too, `auto` for the distance at rest",
                         );
                     }
                 }
@@ -127,8 +127,8 @@ impl Builder<'_> {
                 at.diag(
                     DiagnosticCode::BadLabel,
                     first.col,
-                    "`auto` is a reserved word in a 3-D script (the distance at rest, 3-D spec \
-                     §1.7): choose another parameter name",
+                    "`auto` is a reserved word in a 3-D script (the distance at rest): choose \
+                     another parameter name",
                 )
                 .with_found("@auto"),
             );
@@ -392,7 +392,7 @@ impl Builder<'_> {
                 at.diag(
                     DiagnosticCode::ZeroDirection,
                     t.col,
-                    "a direction cannot be the zero vector (3-D spec §1.7)",
+                    "a direction cannot be the zero vector",
                 )
                 .with_expected("a non-zero vector such as `[0 0 1]`")
                 .with_found(t.source()),
@@ -479,7 +479,7 @@ impl Builder<'_> {
             item.line,
             col,
             "`~generate` writes 1-D elements: a `~dim 3` script uses the 3-D structures \
-                 (string3, mesh3, lattice3, ring3, icosphere, objMesh; 3-D spec §4)",
+                 (string3, mesh3, lattice3, ring3, icosphere, objMesh)",
         ));
     }
 
@@ -526,8 +526,8 @@ impl Builder<'_> {
             if !ok {
                 let why = if value == "2" {
                     "`~dim 2` is reserved: a planar model is a 3-D one with `massXY` points \
-                     (3-D spec §1.1)"
-                        .to_string()
+                    "
+                    .to_string()
                 } else {
                     format!("unknown dimension `{}`", arg.source())
                 };
@@ -561,7 +561,7 @@ impl Builder<'_> {
                 at.diag(
                     DiagnosticCode::DimensionMismatch,
                     first.col,
-                    format!("`~{name}` is a 3-D directive: add `~dim 3` to make the script three-dimensional (3-D spec §1.10)"),
+                    format!("`~{name}` is a 3-D directive: add `~dim 3` to make the script three-dimensional"),
                 )
                 .with_found(format!("~{name}")),
             );

@@ -97,15 +97,15 @@ pub(super) fn shape_of(keyword: &str) -> Option<Shape3> {
 pub(super) fn one_d_only(keyword: &str) -> Option<&'static str> {
     Some(match keyword {
         "massG" => "use `mass` with gravity, or `~gravity` for a uniform acceleration",
-        "string" | "chain" => "use `string3` (3-D spec §4.1; `fix=none` for a chain)",
+        "string" | "chain" => "use `string3` (`fix=none` for a chain)",
         "mesh" | "cornerMesh" | "closedMesh" => {
-            "use `mesh3` (3-D spec §4.2, with `fix=none`, `corners` or `borders`)"
+            "use `mesh3` (with `fix=none`, `corners` or `borders`)"
         }
         "stiffString" => {
             "a straight string has no central-force bending: use a `lattice3` beam (2×2×N with \
-             `diag`) or `hinge` links on a curved shell (3-D spec §4.8)"
+             `diag`) or `hinge` links on a curved shell"
         }
-        "feltContact" => "the felt is a 1-D law only; use `nlContact` (3-D spec §2.3.2)",
+        "feltContact" => "the felt is a 1-D law only; use `nlContact`",
         _ => return None,
     })
 }

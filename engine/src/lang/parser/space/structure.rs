@@ -118,16 +118,16 @@ impl Builder<'_> {
         let nsizes = kind.num_sizes();
         let mut sizes = Vec::with_capacity(nsizes);
         let mut ok = true;
-        for t in args.get(..nsizes)? {
-            match self.size(t, at) {
-                Some(v) => sizes.push(u32::try_from(v).ok()?),
-                None => ok = false,
-            }
-        }
-        if ok && kind == StructureKind::Icosphere {
+        if kind == StructureKind::Icosphere {
             // S is a subdivision level: 0 is the icosahedron; the node count bounds it.
-            sizes.clear();
             ok = self.level(&args[0], at).map(|s| sizes.push(s)).is_some();
+        } else {
+            for t in args.get(..nsizes)? {
+                match self.size(t, at) {
+                    Some(v) => sizes.push(u32::try_from(v).ok()?),
+                    None => ok = false,
+                }
+            }
         }
         let mut mesh = None;
         let first_arg = if kind == StructureKind::ObjMesh {
