@@ -153,13 +153,29 @@ pub(crate) fn modes(a: &ModesArgs) -> Result<(), Failure> {
     } else {
         "decays from the projected damping"
     };
+    let what = if engine.is_3d() {
+        "degrees of freedom (3-D: one per moving point and free axis)"
+    } else {
+        "moving masses"
+    };
     println!(
-        "{}: {} moving masses at {} Hz; {} modes ({solver}, {damping})",
+        "{}: {} {what} at {} Hz; {} modes ({solver}, {damping})",
         a.model.display(),
         analysis.degrees_of_freedom,
         a.sample_rate,
         analysis.modes.len()
     );
+    if let Some(eq) = engine.static_equilibrium() {
+        let how = if eq.converged {
+            "found"
+        } else {
+            "NOT found (linearised at the best point reached)"
+        };
+        println!(
+            "static equilibrium {how}: {} Newton step(s), largest residual {:.1e} of the typical force",
+            eq.iterations, eq.residual
+        );
+    }
     print!("{}", format_modes(&analysis, false));
     if let Some(why) = &analysis.skipped {
         println!("modal analysis skipped: {why}");

@@ -63,8 +63,9 @@ fn valid_examples_parse_cleanly_and_round_trip() {
         assert_eq!(parse(&print(&spec)).spec, Some(spec.clone()));
         // A 3-D example also builds and plays (struck on every input) without tripping.
         if spec.space.is_some() {
-            let mut e = ressort_engine::compile(&spec, &ressort_engine::CompileOptions::at(48000.0))
-                .unwrap_or_else(|e| panic!("LANGUAGE.md line {}: {e}", b.line));
+            let mut e =
+                ressort_engine::compile(&spec, &ressort_engine::CompileOptions::at(48000.0))
+                    .unwrap_or_else(|e| panic!("LANGUAGE.md line {}: {e}", b.line));
             let (n_in, n_out, frames) = (e.info().num_inputs(), e.info().num_outputs(), 4800);
             let mut input = vec![0.0; n_in * frames];
             for c in 0..n_in {
@@ -72,7 +73,12 @@ fn valid_examples_parse_cleanly_and_round_trip() {
             }
             let mut out = vec![0.0; n_out * frames];
             let report = e.process(frames, &input, &mut out);
-            assert!(!report.tripped, "LANGUAGE.md line {}: {:?}", b.line, e.guard_event());
+            assert!(
+                !report.tripped,
+                "LANGUAGE.md line {}: {:?}",
+                b.line,
+                e.guard_event()
+            );
         }
         count += 1;
     }

@@ -22,6 +22,9 @@ pub struct MotionFrame {
     pub number: u64,
     /// The z of every material point, in generic order.
     pub z: Vec<f32>,
+    /// A 3-D model's x and y of every material point (empty for a 1-D model).
+    pub x: Vec<f32>,
+    pub y: Vec<f32>,
 }
 
 /// A macro structure's nodes in the generic buffer: strings are runs of `count` nodes,
@@ -44,6 +47,9 @@ pub struct MotionView {
     pub y: Vec<f32>,
     /// Every point's position at rest: the view shows the motion around it.
     pub rest: Vec<f32>,
+    /// A 3-D model's rest positions on x and y (empty for a 1-D model; z is `rest`).
+    pub rest_x: Vec<f32>,
+    pub rest_y: Vec<f32>,
     /// The model's metadata: points, owners, named buffers (`info.motion.named`).
     pub info: ModelInfo,
     pub io: Vec<IoPoint>,
@@ -82,6 +88,18 @@ impl MotionView {
                 .iter()
                 .map(|&v| v as f32)
                 .collect(),
+            rest_x: engine
+                .axis(0)
+                .iter()
+                .take(info.num_points)
+                .map(|&v| v as f32)
+                .collect(),
+            rest_y: engine
+                .axis(1)
+                .iter()
+                .take(info.num_points)
+                .map(|&v| v as f32)
+                .collect(),
             info: info.clone(),
             io: engine.io_points(),
             links: engine.links(),
@@ -92,6 +110,11 @@ impl MotionView {
     /// The number of points of the generic buffer.
     pub fn len(&self) -> usize {
         self.info.points.len()
+    }
+
+    /// Whether the model is three-dimensional (its frames carry x and y too).
+    pub fn is_3d(&self) -> bool {
+        !self.rest_x.is_empty()
     }
 
     pub fn is_empty(&self) -> bool {
@@ -195,8 +218,8 @@ impl std::fmt::Debug for MotionWriter {
 }
 
 impl ressort_engine::instrument::Watcher for MotionWriter {
-    fn tick(&mut self, frames: usize, positions: &[f64], watching: bool) {
-        MotionWriter::tick(self, frames, positions, watching);
+    fn tick(&mut self, frames: usize, axes: [&[f64]; 3], watching: bool) {
+        MotionWriter::tick(self, frames, axes, watching);
     }
 }
 
@@ -204,7 +227,7 @@ impl MotionWriter {
     /// Called after every chunk of `frames` samples. When the editor is open and a frame is
     /// due, copies the material points' positions and publishes them. Realtime-safe.
     #[inline]
-    pub fn tick(&mut self, frames: usize, positions: &[f64], editor_open: bool) {
+    pub fn tick(&mut self, frames: usize, axes: [&[f64]; 3], editor_open: bool) {
         self.elapsed += frames as u64;
         if !editor_open || self.elapsed < self.interval {
             return;
@@ -213,9 +236,14 @@ impl MotionWriter {
         self.published += 1;
         let frame = self.input.input_buffer_mut();
         frame.number = self.published;
-        for (z, p) in frame.z.iter_mut().zip(positions) {
-            *z = if p.is_finite() { *p as f32 } else { 0.0 };
-        }
+        let copy = |to: &mut [f32], from: &[f64]| {
+            for (v, p) in to.iter_mut().zip(from) {
+                *v = if p.is_finite() { *p as f32 } else { 0.0 };
+            }
+        };
+        copy(&mut frame.z, axes[2]);
+        copy(&mut frame.x, axes[0]);
+        copy(&mut frame.y, axes[1]);
         self.input.publish();
     }
 
@@ -249,9 +277,12 @@ impl MotionReader {
 /// A writer and reader for a compiled model, at `sample_rate`.
 pub fn motion_channel(engine: &Engine, sample_rate: f64) -> (MotionWriter, MotionReader) {
     let view = MotionView::of(engine);
+    let planar = if view.is_3d() { view.len() } else { 0 };
     let frame = MotionFrame {
         number: 0,
         z: vec![0.0; view.len()],
+        x: vec![0.0; planar],
+        y: vec![0.0; planar],
     };
     let (input, output) = triple_buffer::triple_buffer(&frame);
     let interval = (sample_rate / MOTION_FRAME_RATE).round().max(1.0) as u64;
@@ -306,12 +337,12 @@ mod tests {
         assert_eq!(r.view.rest[h], 0.1, "the hammer rests at 0.1");
         let mut positions = vec![0.25; e.positions().len()];
         for _ in 0..100 {
-            w.tick(16, &positions, false);
+            w.tick(16, [&[], &[], &positions], false);
         }
         assert_eq!(r.latest().number, 0, "closed editor: nothing published");
         // 400 samples per frame at 48 kHz: 25 chunks of 16.
         for _ in 0..25 {
-            w.tick(16, &positions, true);
+            w.tick(16, [&[], &[], &positions], true);
         }
         let f = r.latest();
         assert_eq!(f.number, 1);
@@ -319,7 +350,7 @@ mod tests {
         assert!(f.z.iter().all(|&z| z == 0.25));
         positions[3] = f64::NAN;
         for _ in 0..25 {
-            w.tick(16, &positions, true);
+            w.tick(16, [&[], &[], &positions], true);
         }
         let f = r.latest();
         assert_eq!((f.number, f.z[3], f.z[4]), (2, 0.0, 0.25));

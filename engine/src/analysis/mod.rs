@@ -8,5 +8,5 @@ pub(crate) mod concurrent;
 pub mod envelope;
 pub mod modes;
 pub(crate) mod network;
-pub(crate) mod space;
+pub mod space;
 pub mod stability;

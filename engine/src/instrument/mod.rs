@@ -771,11 +771,11 @@ impl Instrument {
                 );
                 bank.free_silent(len);
                 if let Some(w) = m.watcher.as_mut() {
-                    let positions = match bank.newest() {
-                        Some(i) => bank.positions(i).0,
-                        None => m.engine.positions(),
+                    let axes = match bank.newest() {
+                        Some(i) => bank.axes(i),
+                        None => m.engine.axes(),
                     };
-                    w.tick(len, positions, self.watching);
+                    w.tick(len, axes, self.watching);
                 }
             } else {
                 if strike > 0.0 {
@@ -802,7 +802,7 @@ impl Instrument {
                         .process(len, &m.inputs[..n_in * len], &mut m.outputs[..n_out * len]);
                 tripped |= r.tripped;
                 if let Some(w) = m.watcher.as_mut() {
-                    w.tick(len, m.engine.positions(), self.watching);
+                    w.tick(len, m.engine.axes(), self.watching);
                 }
             }
         }

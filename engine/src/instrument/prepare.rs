@@ -16,8 +16,8 @@ use crate::analysis::envelope::{
     envelope, exact_envelope, raw_envelope, worst_load, StabilityEnvelope,
 };
 use crate::{
-    compile, parse, CompileOptions, Engine, ExciterKind, InputUse, ModelSpec, RouteSource,
-    SampleRateMode, REFERENCE_SAMPLE_RATE_HZ,
+    compile, CompileOptions, Engine, ExciterKind, InputUse, ModelSpec, RouteSource, SampleRateMode,
+    REFERENCE_SAMPLE_RATE_HZ,
 };
 use std::fmt;
 use std::sync::Arc;
@@ -26,7 +26,8 @@ use std::sync::Arc;
 /// view). It runs on the audio thread: it must not allocate, lock or block.
 pub trait Watcher: Send + fmt::Debug {
     /// `frames` samples were rendered; `watching` says whether anyone looks (an open editor).
-    fn tick(&mut self, frames: usize, positions: &[f64], watching: bool);
+    /// `axes` are the positions on x, y and z (a 1-D model's x and y are empty).
+    fn tick(&mut self, frames: usize, axes: [&[f64]; 3], watching: bool);
 }
 
 /// The key a pitched model sits at before any note, in concert pitch: C4, where its level is

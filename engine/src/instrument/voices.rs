@@ -326,6 +326,18 @@ impl VoiceBank {
         }
     }
 
+    /// Voice `i`'s positions on x, y and z ([`Engine::axes`]; a lane group's, 1-D, on z).
+    /// Realtime-safe.
+    pub fn axes(&mut self, i: usize) -> [&[f64]; 3] {
+        match &self.copies {
+            Copies::Engines(e) => e[i].axes(),
+            Copies::Lanes(g) => {
+                g[i / LANES].lane_state(i % LANES, &mut self.x, &mut self.xp);
+                [&[], &[], &self.x]
+            }
+        }
+    }
+
     /// Voice `i`'s positions and delayed positions. Realtime-safe.
     pub fn positions(&mut self, i: usize) -> (&[f64], &[f64]) {
         match &self.copies {

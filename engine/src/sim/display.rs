@@ -93,3 +93,75 @@ pub(crate) fn links(
         .filter(|(a, b)| a != b)
         .collect()
 }
+
+/// A 3-D model's point for a display: a connection point's heaviest node.
+fn space_point(space: &crate::sim::space::Space, num_points: usize, index: u32) -> Option<u32> {
+    let i = index as usize;
+    if i < num_points {
+        return Some(index);
+    }
+    let p = i - num_points;
+    let def = space.model.proxies.get(p)?;
+    let w = space.proxy_weights.get(p)?;
+    let best = (0..def.width()).max_by(|&a, &b| w[a].total_cmp(&w[b]))?;
+    space.proxy_nodes.get(p).map(|n| n[best])
+}
+
+/// A 3-D model's inputs and outputs on material points (3-D spec §3), as [`io_points`].
+pub(crate) fn space_io_points(space: &crate::sim::space::Space, num_points: usize) -> Vec<IoPoint> {
+    use crate::sim::space::{Avatar, ForceInput, Output3, Probe3};
+    let m = &space.model;
+    let mut out = Vec::new();
+    let mut push = |kind: IoKind, channel: u32, index: u32| {
+        if let Some(point) = space_point(space, num_points, index) {
+            out.push(IoPoint {
+                kind,
+                channel: channel + 1,
+                point,
+            });
+        }
+    };
+    for fi in &m.force_inputs {
+        let (ForceInput::Line { point, channel, .. } | ForceInput::Xyz { point, channel }) = *fi;
+        push(IoKind::ForceInput, channel, point);
+    }
+    for av in &m.avatars {
+        let (Avatar::Line { point, channel, .. } | Avatar::Xyz { point, channel }) = *av;
+        push(IoKind::PositionInput, channel, point);
+    }
+    for o in &m.outputs {
+        match *o {
+            Output3::Point {
+                channel,
+                probe: Probe3::Force,
+                point,
+                ..
+            } => push(IoKind::ForceOutput, channel, point),
+            Output3::Point { channel, point, .. } => push(IoKind::PositionOutput, channel, point),
+            Output3::Distance { channel, a, .. } => push(IoKind::PositionOutput, channel, a),
+            Output3::Mic { channel, mic } => {
+                if let Some(&p) = m.mics[mic as usize].members.first() {
+                    push(IoKind::PositionOutput, channel, p);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Every link of a 3-D model, structures' included, as pairs of material points.
+pub(crate) fn space_links(space: &crate::sim::space::Space, num_points: usize) -> Vec<(u32, u32)> {
+    space
+        .model
+        .groups
+        .iter()
+        .flat_map(|g| g.a.iter().zip(&g.b))
+        .filter_map(|(&a, &b)| {
+            Some((
+                space_point(space, num_points, a)?,
+                space_point(space, num_points, b)?,
+            ))
+        })
+        .filter(|(a, b)| a != b)
+        .collect()
+}

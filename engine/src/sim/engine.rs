@@ -207,14 +207,26 @@ impl Engine {
     /// input, position input (its avatar), position output and force output, located on a
     /// material point of the generic motion buffer.
     pub fn io_points(&self) -> Vec<IoPoint> {
-        display::io_points(&self.model, &self.proxies)
+        match &self.space {
+            Some(space) => display::space_io_points(space, self.model.info.num_points),
+            None => display::io_points(&self.model, &self.proxies),
+        }
     }
 
     /// The explicit interactions as pairs of material points (connection points replaced by
     /// their heaviest node), for drawing a structure. Macro-internal links are not listed:
     /// they join consecutive nodes of a string and neighbours of a mesh (spec §2.7).
     pub fn links(&self) -> Vec<(u32, u32)> {
-        display::links(&self.model, &self.proxies, &self.interactions)
+        match &self.space {
+            // A 3-D model's structures are links like any other (3-D spec §4.0).
+            Some(space) => display::space_links(space, self.model.info.num_points),
+            None => display::links(&self.model, &self.proxies, &self.interactions),
+        }
+    }
+
+    /// The positions of every point on each axis, x, y, z: a 1-D model's x and y are empty.
+    pub fn axes(&self) -> [&[f64]; 3] {
+        [self.axis(0), self.axis(1), self.axis(2)]
     }
 
     /// The sample rate the model was compiled for, in Hz.

@@ -275,3 +275,29 @@ pub(crate) fn equilibrium(e: &Engine) -> Equilibrium {
         residual: r / typical.max(f64::MIN_POSITIVE),
     }
 }
+
+/// How the static equilibrium of a 3-D model was found (3-D spec §6.1), for reports.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EquilibriumReport {
+    /// The residual force met the tolerance (10⁻¹² of the typical force).
+    pub converged: bool,
+    /// Newton steps taken (0 when the initial geometry is already at rest).
+    pub iterations: usize,
+    /// The largest residual force left, relative to the typical force.
+    pub residual: f64,
+}
+
+impl Engine {
+    /// A 3-D model's static equilibrium as the modal analysis finds it (None for a 1-D
+    /// model, which is linearised at its stage-0 positions). Off the audio thread.
+    pub fn static_equilibrium(&mut self) -> Option<EquilibriumReport> {
+        self.space.as_ref()?;
+        self.apply_pending_changes();
+        let eq = equilibrium(self);
+        Some(EquilibriumReport {
+            converged: eq.converged,
+            iterations: eq.iterations,
+            residual: eq.residual,
+        })
+    }
+}

@@ -19,7 +19,7 @@ use crate::sim::space::links::MAX_SLOTS;
 use crate::sim::space::Space;
 use crate::Engine;
 
-pub(crate) mod equilibrium;
+pub mod equilibrium;
 pub(crate) mod system;
 
 /// One link of a 3-D model: its law, endpoints, element and argument values.

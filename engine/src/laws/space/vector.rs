@@ -62,12 +62,6 @@ pub(crate) fn scale<A: Arith>(a: &A, s: A::F, v: V3<A::F>) -> V3<A::F> {
     v.map(|c| a.mul(s, c))
 }
 
-/// u + v.
-#[inline(always)]
-pub(crate) fn add<A: Arith>(a: &A, u: V3<A::F>, v: V3<A::F>) -> V3<A::F> {
-    [0, 1, 2].map(|c| a.add(u[c], v[c]))
-}
-
 /// v / |v|, or 0 for a zero (or non-finite) vector: a direction argument (3-D spec §1.7),
 /// normalised where it is used, so that a direction moved by a parameter stays a unit vector;
 /// a zero direction applies no force.

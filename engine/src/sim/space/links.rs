@@ -38,19 +38,6 @@ impl Group3 {
     pub fn len(&self) -> usize {
         self.a.len()
     }
-
-    /// The argument slots of link `l`.
-    pub fn slots(&self, l: usize) -> impl Iterator<Item = usize> + '_ {
-        let seg = self
-            .segments
-            .iter()
-            .find(|s| (s.start as usize..(s.start + s.len) as usize).contains(&l));
-        let (base, step, i) = match seg {
-            Some(s) => (s.base, s.step, (l - s.start as usize) as u32),
-            None => ([0; MAX_SLOTS], [0; MAX_SLOTS], 0),
-        };
-        (0..MAX_SLOTS).map(move |c| (base[c] + step[c] * i) as usize)
-    }
 }
 
 /// One group's links on the three axes.
