@@ -637,8 +637,9 @@ fn voices_on_one_note_share_gains_only_with_the_same_modulation() {
 struct Recorder(std::sync::Arc<std::sync::Mutex<Vec<Vec<f64>>>>);
 
 impl instrument::Watcher for Recorder {
-    fn tick(&mut self, _frames: usize, positions: &[f64], _watching: bool) {
-        self.0.lock().unwrap().push(positions.to_vec());
+    fn tick(&mut self, _frames: usize, axes: [&[f64]; 3], _watching: bool) {
+        // 1-D models move along z, the third axis.
+        self.0.lock().unwrap().push(axes[2].to_vec());
     }
 }
 
