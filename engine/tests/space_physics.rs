@@ -3,6 +3,8 @@
 //! momentum (§7.7), rotation invariance (§7.8), a bouncing ball's restitution (§7.9), a
 //! pendulum (§7.10) and the 1-D embedding (§1.8, §7.11).
 
+mod common;
+
 use ressort_engine::{compile, parse, CompileOptions, Engine};
 
 const SR: f64 = 44_100.0;
@@ -450,4 +452,32 @@ fn a_1d_model_embedded_in_3d_moves_the_same_along_z() {
         );
         assert!(worst <= 1e-10 * peak.max(1.0), "out{}: {worst}", ch + 1);
     }
+}
+
+/// An `audioParam` of a 3-D script reads its own input channel, as in 1-D: the plectrum's grip
+/// on in2 is 0 at rest (the sweep on in1 leaves the string still) and plucks once in2 opens.
+#[test]
+fn an_audio_param_of_a_3d_script_has_its_input() {
+    let text = "~dim 3\n@nlK audioParam @in2\n\
+                @s string3 11 1. 0.05 0.0002 [0 0 0] [10 0 0] [0.9*auto]\n\
+                @in1 posInput [3 0 -0.5] [0 0 1]\n\
+                @p nlPluck @in1 @s_m3 nlK 0.1 0 [0 0 1]\n\
+                @out1 posOutput @s_m6\n";
+    let mut e = common::engine(&common::spec(text), 48_000.0);
+    assert_eq!(
+        e.info().num_inputs(),
+        2,
+        "in1 and the audio parameter's in2"
+    );
+    let frames = 2_000;
+    let sweep: Vec<f64> = (0..frames)
+        .map(|n| -0.5 + (n as f64 / frames as f64).min(1.0))
+        .collect();
+    let closed = common::render(&mut e, frames, 64, &[sweep.clone(), vec![0.0; frames]]);
+    let still = closed[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    e.reset();
+    let open = common::render(&mut e, frames, 64, &[sweep, vec![0.05; frames]]);
+    let plucked = open[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    println!("grip 0: peak {still:.3e}; grip 0.05: peak {plucked:.3e}");
+    assert!(still < 1e-12 && plucked > 1e-3, "{still} {plucked}");
 }

@@ -11,7 +11,7 @@ use crate::compile::{CompileOptions, Rate};
 use crate::laws::NUM_ARG_CLASSES;
 use crate::sim::control::ControlArgs;
 use crate::sim::engine::{Compiled, Engine, Points, DEFAULT_POSITION_LIMIT};
-use crate::sim::info::{ModelInfo, ParamInfo};
+use crate::sim::info::{InputUse, ModelInfo, ParamInfo};
 use crate::sim::motion::{MotionLayout, NamedBuffer};
 use crate::sim::space::{Space, SpaceModel};
 use std::sync::Arc;
@@ -61,6 +61,12 @@ impl<'a> Cx<'a> {
                 }
             }
         }
+        // An audio-rate parameter reads its own input channel, as in 1-D.
+        let mut inputs = b.inputs;
+        for r in &params.audio {
+            let name = self.spec.params[r.index as usize].name.clone();
+            super::bind::use_input(&mut inputs, r.channel + 1, InputUse::Param(name));
+        }
         let info = ModelInfo {
             sample_rate_hz: rate.sr,
             sample_rate_mode: rate.mode,
@@ -75,7 +81,7 @@ impl<'a> Cx<'a> {
                 .zip(&self.param_is_coordinate)
                 .map(|(p, &coordinate)| ParamInfo { coordinate, ..p })
                 .collect(),
-            inputs: b.inputs,
+            inputs,
             outputs: b.output_uses,
             motion,
         };

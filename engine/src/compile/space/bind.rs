@@ -758,7 +758,7 @@ impl<'a> Cx<'a> {
     }
 }
 
-fn use_input(inputs: &mut Vec<Vec<InputUse>>, channel: u32, u: InputUse) {
+pub(super) fn use_input(inputs: &mut Vec<Vec<InputUse>>, channel: u32, u: InputUse) {
     let c = channel as usize;
     if inputs.len() < c {
         inputs.resize(c, Vec::new());
