@@ -99,6 +99,15 @@ pub const PRESETS: &[Preset] = presets![
     "duffing",
     "friction-squeal",
     "rattle",
+    // Models in space (~dim 3), in their categories' order.
+    "glide-string",
+    "plucked-string-3d",
+    "bowed-string-3d",
+    "mesh-bell",
+    "ball-on-drum",
+    "rope-and-plate",
+    "pendulum-chain",
+    "newtons-cradle",
 ];
 
 /// The model a new instance starts with.
