@@ -101,11 +101,36 @@ fn apply<L: SpaceLaw>(g: &Group3, x: &mut Points, y: &mut Points, z: &mut Points
 /// The most links [`apply_vector`] evaluates at once (AVX-512's eight `f64`s).
 const MAX_WIDTH: usize = 8;
 
+/// The three axes as slices of one length `n`, so that one comparison of an endpoint index
+/// with `n` stands for the bounds checks of all nine arrays.
+struct View<'a> {
+    n: usize,
+    x: [&'a [f64]; 3],
+    xp: [&'a [f64]; 3],
+    f: [&'a mut [f64]; 3],
+}
+
+impl<'a> View<'a> {
+    #[inline(always)]
+    fn new(x: &'a mut Points, y: &'a mut Points, z: &'a mut Points) -> View<'a> {
+        let n = x.x.len();
+        View {
+            n,
+            x: [&x.x[..n], &y.x[..n], &z.x[..n]],
+            xp: [&x.xp[..n], &y.xp[..n], &z.xp[..n]],
+            f: [&mut x.f[..n], &mut y.f[..n], &mut z.f[..n]],
+        }
+    }
+}
+
 /// One group's links on the three axes, `S::F64_LANES` links at a time: their endpoints and
 /// arguments gathered into one native vector per coordinate, the law evaluated once on
 /// [`Native`] (each lane the scalar law's IEEE operations in the same order, so each link's
 /// g has the scalar path's bits), then g applied link by link in link order as [`apply`]
-/// does, so every force sums in the same order. The segment's remainder runs [`one`].
+/// does, so every force sums in the same order. A chunk whose links are a chain (endpoints
+/// at consecutive points, a string or a mesh row) loads its coordinates as vectors; an
+/// argument with its own slot per link (step 1) is one vector load. The segment's remainder
+/// runs [`one`].
 #[inline(always)]
 fn apply_vector<L: SpaceLaw, S: Simd>(
     simd: S,
@@ -117,8 +142,9 @@ fn apply_vector<L: SpaceLaw, S: Simd>(
 ) {
     let w = S::F64_LANES;
     let slots = L::ROW.slots();
+    let two = L::ROW.endpoints != 1;
     let arith = Native(simd);
-    let load = |v: &[f64; MAX_WIDTH]| S::as_simd_f64s(&v[..]).0[0];
+    let load = |v: &[f64]| S::as_simd_f64s(&v[..w]).0[0];
     for seg in &g.segments {
         let len = seg.len as usize;
         let full = len - len % w;
@@ -129,45 +155,76 @@ fn apply_vector<L: SpaceLaw, S: Simd>(
                 shared[c] = simd.splat_f64s(args[seg.base[c] as usize]);
             }
         }
+        let v = View::new(x, y, z);
         let mut i = 0;
         while i < full {
             let start = seg.start as usize + i;
             let (la, lb) = (&g.a[start..start + w], &g.b[start..start + w]);
-            // Endpoint coordinates: x₁, x̃₁, x₂, x̃₂ on each axis, lane k the link i + k.
-            let mut ends = [[0.0; MAX_WIDTH]; 12];
-            for k in 0..w {
-                let (a, b) = (la[k] as usize, lb[k] as usize);
-                for (c, axis) in [&*x, &*y, &*z].into_iter().enumerate() {
-                    ends[c][k] = axis.x[a];
-                    ends[3 + c][k] = axis.xp[a];
-                    ends[6 + c][k] = axis.x[b];
-                    ends[9 + c][k] = axis.xp[b];
+            let (a0, b0) = (la[0] as usize, lb[0] as usize);
+            let chain = (0..w).all(|k| la[k] as usize == a0 + k && lb[k] as usize == b0 + k)
+                && a0 + w <= v.n
+                && b0 + w <= v.n;
+            let e = if chain {
+                Ends {
+                    x1: [0, 1, 2].map(|c| load(&v.x[c][a0..])),
+                    xp1: [0, 1, 2].map(|c| load(&v.xp[c][a0..])),
+                    x2: [0, 1, 2].map(|c| load(&v.x[c][b0..])),
+                    xp2: [0, 1, 2].map(|c| load(&v.xp[c][b0..])),
                 }
-            }
+            } else {
+                // Endpoint coordinates: x₁, x̃₁, x₂, x̃₂ on each axis, lane k the link i + k.
+                let mut ends = [[0.0; MAX_WIDTH]; 12];
+                for k in 0..w {
+                    let (a, b) = (la[k] as usize, lb[k] as usize);
+                    assert!(a < v.n && b < v.n);
+                    for c in 0..3 {
+                        ends[c][k] = v.x[c][a];
+                        ends[3 + c][k] = v.xp[c][a];
+                        ends[6 + c][k] = v.x[c][b];
+                        ends[9 + c][k] = v.xp[c][b];
+                    }
+                }
+                Ends {
+                    x1: [0, 1, 2].map(|c| load(&ends[c])),
+                    xp1: [3, 4, 5].map(|c| load(&ends[c])),
+                    x2: [6, 7, 8].map(|c| load(&ends[c])),
+                    xp2: [9, 10, 11].map(|c| load(&ends[c])),
+                }
+            };
             let mut p = shared;
             for c in 0..slots {
-                if seg.step[c] != 0 {
-                    let mut v = [0.0; MAX_WIDTH];
-                    for (k, v) in v[..w].iter_mut().enumerate() {
-                        *v = args[(seg.base[c] + seg.step[c] * (i + k) as u32) as usize];
+                match seg.step[c] {
+                    0 => {}
+                    1 => {
+                        let at = (seg.base[c] as usize) + i;
+                        p[c] = load(&args[at..at + w]);
                     }
-                    p[c] = load(&v);
+                    step => {
+                        let mut a = [0.0; MAX_WIDTH];
+                        for (k, a) in a[..w].iter_mut().enumerate() {
+                            *a = args[(seg.base[c] + step * (i + k) as u32) as usize];
+                        }
+                        p[c] = load(&a);
+                    }
                 }
             }
-            let e = Ends {
-                x1: [0, 1, 2].map(|c| load(&ends[c])),
-                xp1: [3, 4, 5].map(|c| load(&ends[c])),
-                x2: [6, 7, 8].map(|c| load(&ends[c])),
-                xp2: [9, 10, 11].map(|c| load(&ends[c])),
-            };
             let f = L::force(&arith, &e, |c| p[c]);
             let mut out = [[0.0; MAX_WIDTH]; 3];
             for (o, f) in out.iter_mut().zip(f) {
                 S::as_mut_simd_f64s(&mut o[..]).0[0] = f;
             }
+            // F₁ −= g, F₂ += g, link by link.
             for k in 0..w {
-                let gk = [out[0][k], out[1][k], out[2][k]];
-                spread::<L>(gk, la[k] as usize, lb[k] as usize, x, y, z);
+                let (a, b) = (la[k] as usize, lb[k] as usize);
+                assert!(a < v.n && b < v.n);
+                for c in 0..3 {
+                    v.f[c][a] -= out[c][k];
+                }
+                if two {
+                    for c in 0..3 {
+                        v.f[c][b] += out[c][k];
+                    }
+                }
             }
             i += w;
         }
