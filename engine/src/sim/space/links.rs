@@ -155,7 +155,7 @@ fn apply_vector<L: SpaceLaw, S: Simd>(
                 shared[c] = simd.splat_f64s(args[seg.base[c] as usize]);
             }
         }
-        let v = View::new(x, y, z);
+        let mut v = View::new(x, y, z);
         let mut i = 0;
         while i < full {
             let start = seg.start as usize + i;
@@ -213,7 +213,24 @@ fn apply_vector<L: SpaceLaw, S: Simd>(
             for (o, f) in out.iter_mut().zip(f) {
                 S::as_mut_simd_f64s(&mut o[..]).0[0] = f;
             }
-            // F₁ −= g, F₂ += g, link by link.
+            // F₁ −= g, F₂ += g, link by link. On a chain whose second endpoints follow its
+            // first ones (b = a + 1), point a + k gets + g(k − 1) from link k − 1, then
+            // − g(k) from link k, and nothing in between: each force is one read, those two
+            // operations in that order and one write, point by point, instead of a chain of
+            // read-modify-writes through memory.
+            if chain && two && b0 == a0 + 1 {
+                for (c, f) in v.f.iter_mut().enumerate() {
+                    let o = &out[c];
+                    let f = &mut f[a0..a0 + w + 1];
+                    f[0] -= o[0];
+                    for k in 1..w {
+                        f[k] = (f[k] + o[k - 1]) - o[k];
+                    }
+                    f[w] += o[w - 1];
+                }
+                i += w;
+                continue;
+            }
             for k in 0..w {
                 let (a, b) = (la[k] as usize, lb[k] as usize);
                 assert!(a < v.n && b < v.n);
