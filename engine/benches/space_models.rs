@@ -447,6 +447,23 @@ fn cpu_model() -> String {
         .unwrap_or_else(|| "unknown CPU".to_string())
 }
 
+/// Today's date (UTC), as YYYY-MM-DD: days since 1970 to the civil calendar.
+fn today() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let z = (secs / 86_400) as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02}")
+}
+
 fn verdict(met: bool) -> &'static str {
     if met {
         "met"
@@ -582,13 +599,16 @@ fn main() {
         let text = format!(
             "# Three-dimensional models benchmark\n\n\
              Produced by `cargo bench -p ressort-engine --bench space_models -- --save` \
-             (`engine/benches/space_models.rs`; its module documentation describes each row).\n\n\
+             (`engine/benches/space_models.rs`; its module documentation describes each row), \
+             {}. Earlier figures and what changed between them are in \
+             `docs/performance-history.md`.\n\n\
              Machine: {} ({} logical cores). Engines: sample rate {} Hz, blocks of {} frames, \
              median of {} runs of about 0.25 s, struck from rest by an impulse of −0.01 on in1 \
              at the start of every simulated second. Voice bank: the instrument, blocks of {} \
              frames, median of {} runs of about 0.5 s, {} notes held and sounding. Load: the \
              median of at least {} runs, the OBJ file read from a temporary folder in each.\n\n\
              {table}\n{sums}",
+            today(),
             cpu_model(),
             std::thread::available_parallelism()
                 .map(|n| n.get())
