@@ -861,7 +861,7 @@ impl Engine {
             space.derive_audio(&self.args);
         }
         // Stages 2 to 5.
-        space.step(&mut self.points, &self.args, input);
+        space.step(&mut self.points, &self.args, input, self.arch);
     }
 
     /// Samples `start..frames` of a block at a fixed point ([`Rest::Fixed`], `rest.rs`): the

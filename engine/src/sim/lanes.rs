@@ -25,6 +25,7 @@ mod links;
 mod structures;
 mod vector;
 
+pub(crate) use arith::Native;
 use links::Stage4;
 use vector::Ops;
 

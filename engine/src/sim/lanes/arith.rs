@@ -13,7 +13,7 @@ use std::marker::PhantomData;
 
 /// [`Arith`] on one native vector of the instruction set `S`.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Native<S>(pub S);
+pub(crate) struct Native<S>(pub S);
 
 impl<S: Simd> Native<S> {
     /// `op` on each element of `v`, through memory.

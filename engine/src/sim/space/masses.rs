@@ -65,18 +65,68 @@ impl Run {
     }
 }
 
-/// Stage 2 on the axes `p` (x, y, z): every run, then the still points' forces cleared.
+impl RunCoef {
+    /// The same coefficients, bit for bit.
+    fn same(&self, o: &RunCoef) -> bool {
+        let bits = |k: &RunCoef| {
+            let mut v = [k.a, k.b, k.inv_m, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+            v[3..6].copy_from_slice(&k.g);
+            v[6..].copy_from_slice(&k.acc);
+            v.map(f64::to_bits)
+        };
+        bits(self) == bits(o)
+    }
+}
+
+/// Which runs update as one (`spans[i]` runs from run i, 0 inside a span): consecutive runs of
+/// adjacent points with the same axes, no rest position, no audio-rate argument (`audio[i]`)
+/// and coefficients equal bit for bit. A script written element by element has a run per
+/// mass; as one run its masses are one loop instead of a thousand. Each point's update is the
+/// same operations on the same values, so the merged phase gives the same bits. One entry
+/// per run, so that re-deriving never allocates.
+pub(crate) fn merge(runs: &[Run], coef: &[RunCoef], audio: &[bool], spans: &mut [u32]) {
+    let mut i = 0;
+    while i < runs.len() {
+        let mut n = 1;
+        let alone = |j: usize| runs[j].rest.is_some() || audio[j];
+        if !alone(i) {
+            while i + n < runs.len() {
+                let (prev, next) = (&runs[i + n - 1], &runs[i + n]);
+                if alone(i + n)
+                    || next.first != prev.first + prev.count
+                    || next.axes != runs[i].axes
+                    || !coef[i + n].same(&coef[i])
+                {
+                    break;
+                }
+                n += 1;
+            }
+        }
+        spans[i] = n as u32;
+        spans[i + 1..i + n].fill(0);
+        i += n;
+    }
+}
+
+/// Stage 2 on the axes `p` (x, y, z): every span of runs ([`merge`]) by its first run's law,
+/// then the still points' forces cleared.
 #[inline(always)]
 pub(crate) fn step(
     runs: &[Run],
     coef: &[RunCoef],
+    spans: &[u32],
     rest: &[[f64; 3]],
     still: &[u32],
     p: [&mut Points; 3],
 ) {
     let [px, py, pz] = p;
-    for (run, k) in runs.iter().zip(coef) {
-        let range = run.first as usize..(run.first + run.count) as usize;
+    let mut i = 0;
+    while i < runs.len() {
+        let (run, k) = (&runs[i], &coef[i]);
+        let n = (spans[i] as usize).max(1);
+        let last = &runs[i + n - 1];
+        i += n;
+        let range = run.first as usize..(last.first + last.count) as usize;
         for (c, axis) in [&mut *px, &mut *py, &mut *pz].into_iter().enumerate() {
             let (x, xp, f) = (
                 &mut axis.x[range.clone()],

@@ -95,6 +95,10 @@ pub(crate) struct Space {
     pub ay: Points,
     /// Each run's coefficients.
     pub coef: Vec<RunCoef>,
+    /// The runs that update as one ([`masses::merge`]), and which runs read an audio-rate
+    /// argument (never merged).
+    pub spans: Vec<u32>,
+    pub audio_run: Vec<bool>,
     /// The per-step acceleration of `~gravity` and the air friction Za.
     pub acc: [f64; 3],
     pub za: f64,
@@ -128,6 +132,14 @@ impl Space {
             ax: axis(),
             ay: axis(),
             coef: vec![RunCoef::default(); runs],
+            spans: vec![1; runs],
+            audio_run: {
+                let mut audio = vec![false; runs];
+                for &i in &model.audio_runs {
+                    audio[i as usize] = true;
+                }
+                audio
+            },
             acc: [0.0; 3],
             za: 0.0,
             proxy_nodes: vec![[0; 8]; proxies],
@@ -153,6 +165,7 @@ impl Space {
         for (i, run) in m.runs.iter().enumerate() {
             self.coef[i] = run.coefficients(args, self.za, self.acc);
         }
+        masses::merge(&m.runs, &self.coef, &self.audio_run, &mut self.spans);
         for (i, p) in m.proxies.iter().enumerate() {
             p.derive(args, &mut self.proxy_nodes[i], &mut self.proxy_weights[i]);
         }
@@ -190,12 +203,19 @@ impl Space {
     /// Stages 2 to 5 of one sample (3-D spec §1.5): the mass phase, the connection points'
     /// positions, the interactions and force inputs, the connection points' forces.
     #[inline(always)]
-    pub fn step(&mut self, z: &mut Points, args: &[f64], input: &impl Fn(u32) -> f64) {
+    pub fn step(
+        &mut self,
+        z: &mut Points,
+        args: &[f64],
+        input: &impl Fn(u32) -> f64,
+        arch: pulp::Arch,
+    ) {
         let m = &*self.model;
         let (ax, ay) = (&mut self.ax, &mut self.ay);
         masses::step(
             &m.runs,
             &self.coef,
+            &self.spans,
             &self.rest,
             &m.still,
             [&mut *ax, &mut *ay, &mut *z],
@@ -208,7 +228,7 @@ impl Space {
             &self.proxy_weights,
             [&mut *ax, &mut *ay, &mut *z],
         );
-        links::step(&m.groups, ax, ay, z, args);
+        links::step(&m.groups, ax, ay, z, args, arch);
         io::force_inputs(
             &m.force_inputs,
             &self.directions,
