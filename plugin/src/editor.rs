@@ -16,7 +16,7 @@ use crate::model::{Loaded, ModelState, ModelStatus, ModelStore, NUM_MACROS};
 use crate::modes_view::ModesView;
 use crate::motion::MotionReader;
 use crate::params::RessortParams;
-use crate::plot::{PlotState, ZMode};
+use crate::plot::PlotState;
 #[cfg(test)]
 use crate::presets::Preset;
 use crate::report::{set_guard_with, HostLink};
@@ -36,6 +36,7 @@ use std::time::Instant;
 mod browser;
 mod controls_panel;
 mod model_panel;
+mod motion_panel;
 mod playing;
 mod vary_panel;
 
@@ -131,6 +132,9 @@ pub struct EditorApp {
     reported_trips: u32,
     reader: Option<MotionReader>,
     plot: PlotState,
+    /// The motion view of 3-D models, and the frames of an animated mode shape it was given.
+    view3d: crate::view3d::View3d,
+    shape_frames: u64,
     /// The Modes view under the motion view, and whether it is open.
     modes: ModesView,
     modes_open: bool,
@@ -196,6 +200,8 @@ impl EditorApp {
             reported_trips: 0,
             reader: None,
             plot: PlotState::default(),
+            view3d: crate::view3d::View3d::default(),
+            shape_frames: 0,
             modes: ModesView::default(),
             modes_open: true,
             tab,
@@ -488,60 +494,6 @@ impl EditorApp {
             ui.add_space(2.0);
             self.modes.show(ui, &mut self.modes_open);
         });
-    }
-
-    fn motion_panel(&mut self, ui: &mut Ui, dt: f32) {
-        let Some(reader) = self.reader.as_mut() else {
-            ui.centered_and_justified(|ui| {
-                ui.label("The motion view starts when the plugin processes audio.");
-            });
-            return;
-        };
-        let view = reader.view.clone();
-        ui.horizontal_wrapped(|ui| {
-            let current = match self.plot.buffer {
-                Some(b) if b < view.named().len() => format!("buffer {}", view.named()[b].name),
-                _ => format!("all points ({})", view.len()),
-            };
-            egui::ComboBox::from_id_salt("buffer")
-                .selected_text(current)
-                .show_ui(ui, |ui| {
-                    ui.selectable_value(
-                        &mut self.plot.buffer,
-                        None,
-                        format!("all points ({})", view.len()),
-                    );
-                    for (i, b) in view.named().iter().enumerate() {
-                        ui.selectable_value(
-                            &mut self.plot.buffer,
-                            Some(i),
-                            format!("buffer {} ({})", b.name, b.members.len()),
-                        );
-                    }
-                });
-            ui.add_enabled_ui(self.plot.planar(), |ui| {
-                egui::ComboBox::from_id_salt("zmode")
-                    .selected_text(self.plot.mode.name())
-                    .show_ui(ui, |ui| {
-                        for m in ZMode::ALL {
-                            ui.selectable_value(&mut self.plot.mode, m, m.name());
-                        }
-                    })
-                    .response
-                    .on_disabled_hover_text("1-D selections show z vertically");
-            });
-            ui.checkbox(&mut self.plot.hold, "Hold scale");
-            if let Some((k, _)) = self.modes.selected_mode() {
-                ui.colored_label(ORANGE, format!("showing the shape of mode {}", k + 1));
-                if ui.small_button("live motion").clicked() {
-                    self.modes.selected = None;
-                }
-            }
-        });
-        match self.modes.shape_frame(&view.rest, dt) {
-            Some(shape) => self.plot.show(ui, &view, shape, dt),
-            None => self.plot.show(ui, &view, &reader.latest().z, dt),
-        };
     }
 }
 

@@ -39,6 +39,7 @@ pub mod report;
 pub mod runtime;
 pub mod state;
 pub mod vary_worker;
+pub mod view3d;
 pub mod voices_watch;
 
 /// Large blocks (the analyses' matrices) go back to the system when freed

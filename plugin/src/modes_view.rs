@@ -43,8 +43,10 @@ pub struct ModesView {
     /// No new request before this: the worker rests at least as long as its last analysis
     /// took, so that automating a control on a large model keeps it below half a core.
     rest_until: Option<Instant>,
-    /// Scratch for the animated shape.
+    /// Scratch for the animated shape (z, and x and y of a 3-D model).
     animated: Vec<f32>,
+    animated_x: Vec<f32>,
+    animated_y: Vec<f32>,
 }
 
 /// Where mode frequencies sit on the horizontal axis: log frequency between `lo` and `hi`.
@@ -229,6 +231,45 @@ impl ModesView {
             .extend(rest.iter().zip(&m.shape).map(|(r, v)| r + s * *v as f32));
         self.phase = phase;
         Some(&self.animated)
+    }
+
+    /// The 3-D counterpart of [`ModesView::shape_frame`]: the selected mode's shape (x, y
+    /// and z of every point, [`Mode::shape`]'s layout for 3-D models) moving around `rest`
+    /// (x, y, z), its largest component `amplitude` long. None when no mode is selected or
+    /// its shape is not a 3-D one of this many points.
+    pub fn shape_frame_3d(
+        &mut self,
+        rest: [&[f32]; 3],
+        amplitude: f32,
+        dt: f32,
+    ) -> Option<[&[f32]; 3]> {
+        let phase =
+            (self.phase + std::f32::consts::TAU * SHAPE_RATE_HZ * dt) % std::f32::consts::TAU;
+        let k = self.selected?;
+        let m = self.result.as_ref()?.modes.analysis.modes.get(k)?;
+        let n = rest[2].len();
+        if m.shape.len() != 3 * n || rest[0].len() != n || rest[1].len() != n {
+            return None;
+        }
+        let s = phase.sin() * amplitude;
+        for (c, out) in [
+            &mut self.animated_x,
+            &mut self.animated_y,
+            &mut self.animated,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            out.clear();
+            out.extend(
+                rest[c]
+                    .iter()
+                    .enumerate()
+                    .map(|(i, r)| r + s * m.shape[3 * i + c] as f32),
+            );
+        }
+        self.phase = phase;
+        Some([&self.animated_x, &self.animated_y, &self.animated])
     }
 
     /// The button that opens and closes the view; closing it deselects the mode.
@@ -592,6 +633,49 @@ mod tests {
         assert!(shape[1] * shape[4] < 0.0, "{shape:?}");
         // A view of another model does not get a frame.
         assert!(v.shape_frame(&rest[..5], 0.01).is_none());
+    }
+
+    #[test]
+    fn a_3d_mode_moves_the_points_along_x_y_and_z() {
+        use ressort_engine::instrument::prepare;
+        let text = "~dim 3\n@s string3 6 1. 0.1 0.001 [0 0 0] [5 0 0] [0.9*auto]\n@in1 frcInput @s_m2 [0 1 0]\n@out1 posOutput @s_m3 [0 1 0]\n";
+        let model = Arc::new(ModalModel::of(&prepare("s", text, 48_000.0).unwrap()));
+        let modes = (*model).clone().modes(&Controls::DEFAULT, None);
+        let mut v = ModesView::default();
+        v.result = Some(ModesResult {
+            id: 1,
+            model,
+            controls: Controls::DEFAULT,
+            modes,
+            elapsed: std::time::Duration::ZERO,
+        });
+        v.selected = Some(0);
+        let rest_x: Vec<f32> = (0..6).map(|i| i as f32).collect();
+        let (rest_y, rest_z) = (vec![0.0f32; 6], vec![0.5f32; 6]);
+        let shape = v.selected_mode().unwrap().1.shape.clone();
+        assert_eq!(shape.len(), 18, "x, y and z of each of the 6 points");
+        assert!(
+            v.shape_frame(&rest_z, 0.01).is_none(),
+            "a 3-D shape is no 1-D frame"
+        );
+        let [x, y, z] = v
+            .shape_frame_3d([&rest_x, &rest_y, &rest_z], 2.0, 0.25 / SHAPE_RATE_HZ)
+            .unwrap();
+        for i in 0..6 {
+            for (c, (axis, rest)) in [(x, &rest_x), (y, &rest_y), (z, &rest_z)]
+                .into_iter()
+                .enumerate()
+            {
+                let want = rest[i] + 2.0 * shape[3 * i + c] as f32;
+                assert!((axis[i] - want).abs() < 1e-5, "point {i} axis {c}");
+            }
+        }
+        // The string's fixed ends do not move; something in between does.
+        assert_eq!((x[0], y[0], z[0]), (0.0, 0.0, 0.5));
+        assert!(shape.iter().any(|v| v.abs() > 0.5));
+        assert!(v
+            .shape_frame_3d([&rest_x[..5], &rest_y[..5], &rest_z[..5]], 2.0, 0.01)
+            .is_none());
     }
 
     #[test]
