@@ -210,7 +210,11 @@ impl VoiceBank {
         // against 461 ns, the 102-point faust-mi string 302 against 978, the 15 × 15 mesh
         // 845 against 2,347).
         let small = engine.positions().len() <= SMALL_MODEL_POINTS;
-        let lanes = (limit >= LANES / 2 || small)
+        // A 3-D model's voices stay engines for now: the lanes step them bit for bit
+        // (engine test `space_lanes`), but the bank's motion display of a lane group
+        // (`VoiceBank::axes`) reads z alone, so the editor's 3-D view would flatten them
+        // (docs/NOTES.md).
+        let lanes = ((limit >= LANES / 2 || small) && !engine.is_3d())
             .then(|| LaneEngine::new(&engine))
             .flatten();
         let (copies, width) = match lanes {

@@ -359,6 +359,17 @@ impl Engine {
         self.space.is_some()
     }
 
+    /// A 3-D model's link count per law of the 3-D table, in [`SpaceLawKind::ALL`] order
+    /// (empty for a 1-D model): what the differential tests check they cover.
+    ///
+    /// [`SpaceLawKind::ALL`]: crate::laws::space::SpaceLawKind::ALL
+    #[doc(hidden)]
+    pub fn space_law_links(&self) -> Vec<usize> {
+        self.space.as_ref().map_or(Vec::new(), |s| {
+            s.model.groups.iter().map(|g| g.len()).collect()
+        })
+    }
+
     /// The positions along axis `c` (0 x, 1 y, 2 z) of every point, in the order of
     /// [`Engine::positions`]: a 1-D model's positions are its z axis, its x and y are empty.
     pub fn axis(&self, c: usize) -> &[f64] {

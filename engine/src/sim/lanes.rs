@@ -22,6 +22,7 @@ use crate::{Engine, ParamError, ParamId};
 
 mod arith;
 mod links;
+mod space;
 mod structures;
 mod vector;
 
@@ -116,15 +117,15 @@ pub struct LaneEngine {
     samples_since_reset: [u64; LANES],
     tripped: [bool; LANES],
     arch: pulp::Arch,
+    /// A 3-D model's lanes (`space.rs`): then the 1-D state above is empty.
+    space: Option<Box<space::SpaceLanes>>,
 }
 
 impl LaneEngine {
     /// Whether a model runs in lanes: no audio-rate parameters (they re-derive arguments
     /// every sample), and at most [`MAX_LANE_POINTS`] points.
     pub fn supports(engine: &Engine) -> bool {
-        // A 3-D model's voices run as engines (its lanes are not written yet).
-        engine.space.is_none()
-            && engine.model.audio_params.is_empty()
+        engine.model.audio_params.is_empty()
             && engine.model.audio_bindings.is_empty()
             && engine.points.x.len() <= MAX_LANE_POINTS
     }
@@ -137,7 +138,16 @@ impl LaneEngine {
         }
         let mut template = template.clone();
         template.reset();
-        let n = template.points.x.len();
+        let space = template
+            .space
+            .is_some()
+            .then(|| Box::new(space::SpaceLanes::new(&template)));
+        // A 3-D model's state is in `space`; the 1-D fields stay empty.
+        let n = if space.is_some() {
+            0
+        } else {
+            template.points.x.len()
+        };
         // Slots no binding writes keep the values the compiler gave them.
         let args = template.args.iter().map(|&v| Lanes([v; LANES])).collect();
         let singles = template.singles.len();
@@ -171,7 +181,11 @@ impl LaneEngine {
             samples_since_reset: [0; LANES],
             tripped: [false; LANES],
             arch: lane_arch(),
+            space,
         };
+        if lanes.space.is_some() {
+            return Some(lanes);
+        }
         lanes.refresh();
         for l in 0..LANES {
             lanes.reset_lane(l);
@@ -187,6 +201,9 @@ impl LaneEngine {
     /// Sets a parameter of every lane (they share parameters), from the next block on.
     /// Realtime-safe.
     pub fn set_param(&mut self, id: ParamId, value: f64) -> Result<(), ParamError> {
+        if let Some(space) = &mut self.space {
+            space.set_param(id, value)?;
+        }
         let before = self.template.param(id);
         self.template.set_param(id, value)?;
         if before != Some(value) {
@@ -203,6 +220,9 @@ impl LaneEngine {
             ScaleClass::Damping => ArgClass::Damping,
             ScaleClass::None | ScaleClass::Gravity => return,
         } as usize;
+        if let Some(space) = &mut self.space {
+            return space.set_class_gain(lane, class, gain);
+        }
         if lane < LANES && gain.is_finite() && gain >= 0.0 && self.gains[lane][slot] != gain {
             self.gains[lane][slot] = gain;
             self.gains_dirty[lane] = true;
@@ -212,6 +232,9 @@ impl LaneEngine {
     /// Puts lane `lane` at the model's initial state (spec §1.5 stage 0) at the current
     /// parameters, and clears its guard. Realtime-safe.
     pub fn reset_lane(&mut self, lane: usize) {
+        if let Some(space) = &mut self.space {
+            return space.reset_lane(lane);
+        }
         if lane >= LANES {
             return;
         }
@@ -242,6 +265,9 @@ impl LaneEngine {
     /// have in `src` (the voice bank packs sounding voices into fewer groups). Both groups run
     /// the same model with the same parameters. Realtime-safe.
     pub fn take_lane(&mut self, to: usize, src: &LaneEngine, from: usize) {
+        if let (Some(d), Some(s)) = (&mut self.space, &src.space) {
+            return d.take_lane(to, s, from);
+        }
         if to >= LANES || from >= LANES {
             return;
         }
@@ -270,12 +296,35 @@ impl LaneEngine {
     /// Whether lane `lane`'s guard has tripped (a non-finite or runaway value): its outputs
     /// stay 0 until [`LaneEngine::reset_lane`].
     pub fn is_tripped(&self, lane: usize) -> bool {
+        if let Some(space) = &self.space {
+            return space.is_tripped(lane);
+        }
         self.tripped.get(lane).copied().unwrap_or(false)
+    }
+
+    /// Lane `lane`'s positions along axis `c` (0 x, 1 y, 2 z, as [`Engine::axis`]), point by
+    /// point, into `out` (as many as it holds): a 1-D model's x and y are empty.
+    pub fn lane_axis(&self, lane: usize, c: usize, out: &mut [f64]) {
+        if lane >= LANES {
+            return;
+        }
+        match &self.space {
+            Some(space) => space.lane_axis(lane, c, out),
+            None if c == 2 => {
+                for (o, v) in out.iter_mut().zip(&self.x) {
+                    *o = v[lane];
+                }
+            }
+            None => {}
+        }
     }
 
     /// Lane `lane`'s positions and delayed positions, point by point, into `x` and `xp`
     /// (as many as they hold).
     pub fn lane_state(&self, lane: usize, x: &mut [f64], xp: &mut [f64]) {
+        if let Some(space) = &self.space {
+            return space.lane_state(lane, x, xp);
+        }
         for (o, v) in x.iter_mut().zip(&self.x) {
             *o = v[lane];
         }
@@ -294,6 +343,9 @@ impl LaneEngine {
             fn with_simd<S: pulp::Simd>(self, simd: S) -> Lanes {
                 let o = Ops(simd);
                 let lanes = self.0;
+                if let Some(space) = &mut lanes.space {
+                    return space.motion(o);
+                }
                 let mut level = Lanes::ZERO;
                 for ((x, xp), last) in lanes.x.iter().zip(&lanes.xp).zip(&mut lanes.last) {
                     level = o.max_abs(o.sub(*x, *xp), level);
@@ -427,6 +479,20 @@ impl LaneEngine {
         let out_channels = outputs.len().checked_div(per_channel).unwrap_or(0);
         let in_channels = inputs.len().checked_div(per_channel).unwrap_or(0);
         outputs[..out_channels * per_channel].fill(0.0);
+        if let Some(space) = &mut self.space {
+            space.refresh();
+            let before: [bool; LANES] = std::array::from_fn(|l| space.is_tripped(l));
+            let arch = self.arch;
+            arch.dispatch(SpaceBlock {
+                lanes: space,
+                frames,
+                inputs,
+                in_channels,
+                outputs,
+                out_channels,
+            });
+            return std::array::from_fn(|l| space.is_tripped(l) && !before[l]);
+        }
         if self.params_dirty || self.gains_dirty.iter().any(|d| *d) {
             self.refresh();
         }
@@ -696,6 +762,32 @@ struct LaneBlock<'a> {
 }
 
 impl pulp::WithSimd for LaneBlock<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
+        self.lanes.run(
+            Ops(simd),
+            self.frames,
+            self.inputs,
+            self.in_channels,
+            self.outputs,
+            self.out_channels,
+        )
+    }
+}
+
+/// One block of a 3-D model's lanes as a pulp operation.
+struct SpaceBlock<'a> {
+    lanes: &'a mut space::SpaceLanes,
+    frames: usize,
+    inputs: &'a [f64],
+    in_channels: usize,
+    outputs: &'a mut [f64],
+    out_channels: usize,
+}
+
+impl pulp::WithSimd for SpaceBlock<'_> {
     type Output = ();
 
     #[inline(always)]
