@@ -5,9 +5,10 @@
 mod common;
 
 use common::{engine, render};
+use ressort_engine::lang::{folder_files, parse_with_files};
 use ressort_engine::spec::REFERENCE_SAMPLE_RATE_HZ;
 use ressort_engine::{
-    parse, reference, ElementKind, Endpoint, ExciterKind, InputUse, LawKind, ModelSpec, OutputUse,
+    reference, ElementKind, Endpoint, ExciterKind, InputUse, LawKind, ModelSpec, OutputUse,
     ParamKind,
 };
 use std::path::PathBuf;
@@ -35,7 +36,9 @@ fn preset(name: &str) -> ModelSpec {
         .iter()
         .find(|f| f.0 == name)
         .unwrap_or_else(|| panic!("models/{name} is missing"));
-    let parsed = parse(text);
+    // A preset in space may import a mesh of models/ (Mesh Bell's bell.obj).
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let parsed = parse_with_files(text, &folder_files(&dir));
     let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
     parsed
         .spec
@@ -124,7 +127,7 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("glide-string.mdl", Some((32, 62))),
     ("plucked-string-3d.mdl", Some((35, 67))),
     ("bowed-string-3d.mdl", Some((35, 67))),
-    ("mesh-bell.mdl", Some((201, 1140))),
+    ("mesh-bell.mdl", Some((201, 2280))),
     ("ball-on-drum.mdl", Some((170, 625))),
     ("rope-and-plate.mdl", Some((88, 375))),
     ("pendulum-chain.mdl", Some((7, 12))),
@@ -310,13 +313,20 @@ fn every_preset_is_stable_and_sounds() {
     const FRAMES: usize = 48_000;
     // Silent outputs are collected, so that one run names every preset that does not play.
     let mut silent = Vec::new();
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models");
     for (name, text) in presets() {
-        let parsed = parse(&text);
+        let parsed = parse_with_files(&text, &folder_files(&dir));
         let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
         assert!(errors.is_empty(), "{name}: {errors:?}");
         let warnings: Vec<String> = parsed.warnings().map(|d| d.to_string()).collect();
         assert!(warnings.is_empty(), "{name}: {warnings:?}");
         let spec = parsed.spec.unwrap();
+        // The presets in space are played through the instrument's exciters, as a key plays
+        // them, by `playing.rs` (level band, tuning, the kick, 22.05 and 192 kHz); this
+        // bare-engine harness reads the avatars and laws of 1-D scripts only.
+        if spec.is_3d() {
+            continue;
+        }
         let mut e = engine(&spec, SR);
         let report = e.stability();
         assert!(report.is_stable(), "{name}: {:?}", report.warnings);
