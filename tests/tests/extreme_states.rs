@@ -58,7 +58,12 @@ fn extreme_values_through_a_state_load_never_panic_hang_or_blast() {
         .map(|(i, s)| (format!("fretted-string variant {i}"), s))
         .collect();
     for (name, text) in presets() {
-        let spec = ressort_engine::parse(&text).spec.expect("a preset parses");
+        let spec = ressort_engine::lang::parse_with_files(
+            &text,
+            &ressort_engine::instrument::meshes::shipped,
+        )
+        .spec
+        .expect("a preset parses");
         let engine = ressort_engine::compile(&spec, &ressort_engine::CompileOptions::at(SR))
             .expect("a preset compiles");
         if engine.positions().len() > 200 {

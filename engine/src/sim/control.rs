@@ -387,9 +387,12 @@ mod tests {
         names.sort();
         assert!(names.len() > 10, "{}", dir.display());
         for path in names {
-            let spec = parse(&std::fs::read_to_string(&path).unwrap())
-                .spec
-                .expect("a preset parses");
+            let spec = crate::lang::parse_with_files(
+                &std::fs::read_to_string(&path).unwrap(),
+                &crate::lang::folder_files(&dir),
+            )
+            .spec
+            .expect("a preset parses");
             let engine = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
             if engine.info().num_points > 5000 {
                 continue;

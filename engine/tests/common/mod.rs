@@ -4,7 +4,14 @@
 pub mod native;
 
 use realfft::RealFftPlanner;
-use ressort_engine::{compile, parse, CompileOptions, Engine, ModelSpec};
+use ressort_engine::lang::{folder_files, parse_with_files, Parsed};
+use ressort_engine::{compile, CompileOptions, Engine, ModelSpec};
+
+/// `text` parsed as a script of `models/`: an `objMesh` line reads its file from there.
+pub fn parse(text: &str) -> Parsed {
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+    parse_with_files(text, &folder_files(&models))
+}
 
 /// The spec of `text`, which must parse without errors (warnings allowed); else the test fails
 /// with the errors and the script's first line.

@@ -655,7 +655,9 @@ mod tests {
         assert!(names.len() > 10);
         for path in names {
             let text = std::fs::read_to_string(&path).unwrap();
-            let spec = parse(&text).spec.expect("a preset parses");
+            let spec = crate::lang::parse_with_files(&text, &crate::lang::folder_files(&dir))
+                .spec
+                .expect("a preset parses");
             let mut plain = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
             plain.arch = pulp::Arch::Scalar;
             let (n_in, n_out) = (plain.info().num_inputs(), plain.info().num_outputs());
