@@ -138,6 +138,15 @@ const LONG_STRING: &str = "\
 @out1 posOutput [@s 0.7]
 ";
 
+/// A pre-tensioned string in space (3-D spec §4.1), struck across its length through a
+/// connection point and heard transversally: its voices run in 3-D lanes.
+const STRING_3D: &str = "\
+~dim 3
+@s string3 24 1. 0.1 0.0005 [0 0 0] [24 0 0] [0.95*auto] 'Zo=1e-5'
+@in1 frcInput [@s 0.3] [0 0.6 0.8]
+@out1 posOutput [@s 0.7] [0 0 1]
+";
+
 #[test]
 fn small_models_run_in_voice_lanes_and_large_ones_on_engines() {
     use ressort_engine::instrument::voices::Copies;
@@ -150,6 +159,7 @@ fn small_models_run_in_voice_lanes_and_large_ones_on_engines() {
     assert!(matches!(bank_of(DAMPED), Copies::Lanes(_)));
     assert!(matches!(bank_of(STRING), Copies::Lanes(_)));
     assert!(matches!(bank_of(LONG_STRING), Copies::Engines(_)));
+    assert!(matches!(bank_of(STRING_3D), Copies::Lanes(_)));
 }
 
 #[test]
@@ -157,6 +167,7 @@ fn a_chord_is_the_sum_of_its_notes() {
     chord_is_the_sum_of_its_notes(STRUCK);
     chord_is_the_sum_of_its_notes(STRING);
     chord_is_the_sum_of_its_notes(LONG_STRING);
+    chord_is_the_sum_of_its_notes(STRING_3D);
 }
 
 fn chord_is_the_sum_of_its_notes(script: &str) {
@@ -194,7 +205,7 @@ fn chord_is_the_sum_of_its_notes(script: &str) {
 fn a_bank_of_one_note_plays_the_monophonic_engine() {
     // One note from rest: a voice of the bank is the engine itself, to the bit.
     let note = [(100u32, Event::note_on(60, 0.8))];
-    for script in [STRUCK, STRING, LONG_STRING] {
+    for script in [STRUCK, STRING, LONG_STRING, STRING_3D] {
         let mono = render(script, 1, quiet(), &note, 24_000).left;
         let poly = render(script, 4, quiet(), &note, 24_000).left;
         assert!(peak(&mono) > 1e-3);
@@ -638,15 +649,25 @@ struct Recorder(std::sync::Arc<std::sync::Mutex<Vec<Vec<f64>>>>);
 
 impl instrument::Watcher for Recorder {
     fn tick(&mut self, _frames: usize, axes: [&[f64]; 3], _watching: bool) {
-        // 1-D models move along z, the third axis.
-        self.0.lock().unwrap().push(axes[2].to_vec());
+        // x, then y, then z: a 1-D model's x and y are empty (it moves along z).
+        self.0.lock().unwrap().push(axes.concat());
     }
 }
 
 /// The positions the motion view is shown, chunk by chunk, while `events` play on 8 voices.
 fn watched(script: &str, events: &[(u32, Event)], frames: usize) -> Vec<Vec<f64>> {
+    watched_on(script, 8, events, frames)
+}
+
+/// [`watched`] on `voices` voices (1: the monophonic engine, no bank).
+fn watched_on(
+    script: &str,
+    voices: usize,
+    events: &[(u32, Event)],
+    frames: usize,
+) -> Vec<Vec<f64>> {
     let mut model = instrument::prepare("test", script, SR).unwrap();
-    model.set_voices(8);
+    model.set_voices(voices);
     let recorder = Recorder::default();
     model.watcher = Some(Box::new(recorder.clone()));
     let mut inst = Instrument::new(SR, quiet());
@@ -686,4 +707,30 @@ fn the_motion_view_shows_the_most_recently_struck_voice() {
         only_first[switch..],
         "the view must leave the first voice"
     );
+}
+
+/// A 3-D model's voice in a lane group shows the motion view all three axes, exactly as the
+/// monophonic engine shows them: the strike, across the string, moves it on y and z.
+#[test]
+fn the_motion_view_of_a_3d_voice_in_lanes_shows_every_axis() {
+    let note = [(0u32, on(60, 0, None))];
+    let frames = 9_600;
+    let lanes = watched_on(STRING_3D, 8, &note, frames);
+    let mono = watched_on(STRING_3D, 1, &note, frames);
+    let points = mono[0].len() / 3;
+    assert!(
+        points >= 24 && mono[0].len() == 3 * points,
+        "x, y and z of each point"
+    );
+    let moved = |axis: usize| {
+        let first = &lanes[0][axis * points..(axis + 1) * points];
+        lanes
+            .iter()
+            .any(|t| t[axis * points..(axis + 1) * points] != *first)
+    };
+    assert!(
+        moved(1) && moved(2),
+        "the strike moves the string on y and z"
+    );
+    assert_eq!(lanes, mono, "a lane shows what the engine alone shows");
 }

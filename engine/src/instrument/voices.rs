@@ -173,6 +173,9 @@ pub struct VoiceBank {
     /// A lane's positions and delayed positions, copied out.
     x: Vec<f64>,
     xp: Vec<f64>,
+    /// A 3-D lane's x and y positions, copied out (empty for a 1-D model).
+    ax: Vec<f64>,
+    ay: Vec<f64>,
     /// How many voices may sound at once (the Voices setting); the rest of the capacity
     /// holds stolen voices while they fade.
     pub limit: usize,
@@ -210,13 +213,13 @@ impl VoiceBank {
         // against 461 ns, the 102-point faust-mi string 302 against 978, the 15 × 15 mesh
         // 845 against 2,347).
         let small = engine.positions().len() <= SMALL_MODEL_POINTS;
-        // A 3-D model's voices stay engines for now: the lanes step them bit for bit
-        // (engine test `space_lanes`), but the bank's motion display of a lane group
-        // (`VoiceBank::axes`) reads z alone, so the editor's 3-D view would flatten them
-        // (docs/NOTES.md).
-        let lanes = ((limit >= LANES / 2 || small) && !engine.is_3d())
+        // A 3-D model's lanes step each voice bit for bit as its own engine would (engine
+        // test `space_lanes`); the motion display reads a lane's three axes (`axes`).
+        let lanes = (limit >= LANES / 2 || small)
             .then(|| LaneEngine::new(&engine))
             .flatten();
+        // A 3-D lane's x and y, copied out for the motion display (z goes to `x`).
+        let planar = if engine.is_3d() { points } else { 0 };
         let (copies, width) = match lanes {
             Some(group) => (Copies::Lanes(vec![group; capacity.div_ceil(LANES)]), LANES),
             None => (Copies::Engines(vec![engine; capacity]), 1),
@@ -255,6 +258,8 @@ impl VoiceBank {
             mixed: vec![0.0; n_out.max(1) * CHUNK * width],
             x: vec![0.0; points],
             xp: vec![0.0; points],
+            ax: vec![0.0; planar],
+            ay: vec![0.0; planar],
             limit,
             clock: 0,
             sustain: false,
@@ -330,14 +335,17 @@ impl VoiceBank {
         }
     }
 
-    /// Voice `i`'s positions on x, y and z ([`Engine::axes`]; a lane group's, 1-D, on z).
-    /// Realtime-safe.
+    /// Voice `i`'s positions on x, y and z, as [`Engine::axes`] gives them (a 1-D model's x
+    /// and y are empty). Realtime-safe.
     pub fn axes(&mut self, i: usize) -> [&[f64]; 3] {
         match &self.copies {
             Copies::Engines(e) => e[i].axes(),
             Copies::Lanes(g) => {
-                g[i / LANES].lane_state(i % LANES, &mut self.x, &mut self.xp);
-                [&[], &[], &self.x]
+                let (group, lane) = (&g[i / LANES], i % LANES);
+                group.lane_state(lane, &mut self.x, &mut self.xp);
+                group.lane_axis(lane, 0, &mut self.ax);
+                group.lane_axis(lane, 1, &mut self.ay);
+                [&self.ax, &self.ay, &self.x]
             }
         }
     }
