@@ -234,9 +234,11 @@ impl ModesView {
     }
 
     /// The 3-D counterpart of [`ModesView::shape_frame`]: the selected mode's shape (x, y
-    /// and z of every point, [`Mode::shape`]'s layout for 3-D models) moving around `rest`
-    /// (x, y, z), its largest component `amplitude` long. None when no mode is selected or
-    /// its shape is not a 3-D one of this many points.
+    /// and z of every point, [`Mode::shape`]'s layout for 3-D models) moving around the
+    /// static equilibrium the analysis linearised it at (a chain hanging under gravity, a
+    /// ball resting on its drum), or around `rest` (x, y, z) when the analysis gives none,
+    /// its largest component `amplitude` long. None when no mode is selected or its shape is
+    /// not a 3-D one of this many points.
     pub fn shape_frame_3d(
         &mut self,
         rest: [&[f32]; 3],
@@ -246,11 +248,13 @@ impl ModesView {
         let phase =
             (self.phase + std::f32::consts::TAU * SHAPE_RATE_HZ * dt) % std::f32::consts::TAU;
         let k = self.selected?;
-        let m = self.result.as_ref()?.modes.analysis.modes.get(k)?;
+        let analysis = &self.result.as_ref()?.modes.analysis;
+        let m = analysis.modes.get(k)?;
         let n = rest[2].len();
         if m.shape.len() != 3 * n || rest[0].len() != n || rest[1].len() != n {
             return None;
         }
+        let equilibrium = (analysis.rest.len() == 3 * n).then_some(&analysis.rest);
         let s = phase.sin() * amplitude;
         for (c, out) in [
             &mut self.animated_x,
@@ -261,12 +265,10 @@ impl ModesView {
         .enumerate()
         {
             out.clear();
-            out.extend(
-                rest[c]
-                    .iter()
-                    .enumerate()
-                    .map(|(i, r)| r + s * m.shape[3 * i + c] as f32),
-            );
+            out.extend(rest[c].iter().enumerate().map(|(i, r)| {
+                let at = equilibrium.map_or(*r, |e| e[3 * i + c] as f32);
+                at + s * m.shape[3 * i + c] as f32
+            }));
         }
         self.phase = phase;
         Some([&self.animated_x, &self.animated_y, &self.animated])
@@ -658,24 +660,62 @@ mod tests {
             v.shape_frame(&rest_z, 0.01).is_none(),
             "a 3-D shape is no 1-D frame"
         );
+        // The shape moves around the string's equilibrium, its declared line (z = 0), not
+        // around the positions the view was handed.
+        let eq = v.result.as_ref().unwrap().modes.analysis.rest.clone();
+        assert_eq!(eq.len(), 18);
         let [x, y, z] = v
             .shape_frame_3d([&rest_x, &rest_y, &rest_z], 2.0, 0.25 / SHAPE_RATE_HZ)
             .unwrap();
         for i in 0..6 {
-            for (c, (axis, rest)) in [(x, &rest_x), (y, &rest_y), (z, &rest_z)]
-                .into_iter()
-                .enumerate()
-            {
-                let want = rest[i] + 2.0 * shape[3 * i + c] as f32;
+            for (c, axis) in [x, y, z].into_iter().enumerate() {
+                let line = if c == 0 { i as f64 } else { 0.0 };
+                assert!((eq[3 * i + c] - line).abs() < 1e-9, "point {i} axis {c}");
+                let want = eq[3 * i + c] as f32 + 2.0 * shape[3 * i + c] as f32;
                 assert!((axis[i] - want).abs() < 1e-5, "point {i} axis {c}");
             }
         }
         // The string's fixed ends do not move; something in between does.
-        assert_eq!((x[0], y[0], z[0]), (0.0, 0.0, 0.5));
+        assert_eq!((x[0], y[0], z[0]), (0.0, 0.0, 0.0));
         assert!(shape.iter().any(|v| v.abs() > 0.5));
         assert!(v
             .shape_frame_3d([&rest_x[..5], &rest_y[..5], &rest_z[..5]], 2.0, 0.01)
             .is_none());
+    }
+
+    /// A bob hanging from a soft spring is drawn swinging around where gravity holds it, below
+    /// its declared place: the mode shapes animate at the static equilibrium (3-D spec §6.1).
+    #[test]
+    fn a_3d_mode_moves_around_the_static_equilibrium() {
+        use ressort_engine::instrument::prepare;
+        let text = "~dim 3\n~gravity 9.81\n@g ground [0 0 0]\n@m mass 1. [0 0 -1] [0 0 0]\n\
+            @l spring @g @m 0.000001 auto\n@in1 frcInput @m [1 0 0]\n@out1 posOutput @m [1 0 0]\n";
+        let model = Arc::new(ModalModel::of(&prepare("s", text, 48_000.0).unwrap()));
+        let modes = (*model).clone().modes(&Controls::DEFAULT, None);
+        let mut v = ModesView::default();
+        v.result = Some(ModesResult {
+            id: 1,
+            model,
+            controls: Controls::DEFAULT,
+            modes,
+            elapsed: std::time::Duration::ZERO,
+        });
+        v.selected = Some(0);
+        let declared = [vec![0.0f32, 0.0], vec![0.0f32, 0.0], vec![0.0f32, -1.0]];
+        // At a zero of the swing the frame is the equilibrium itself.
+        let [x, y, z] = v
+            .shape_frame_3d([&declared[0], &declared[1], &declared[2]], 2.0, 0.0)
+            .unwrap();
+        // The stretch that holds the bob: M·g over K, per step at any rate (K is written as
+        // at 44.1 kHz, gravity in units/s²): 9.81 / (10⁻⁶ · 44 100²) ≈ 5.0e-3 units.
+        let sag = 9.81 / (0.000001 * 44_100.0f64 * 44_100.0);
+        assert_eq!((x[0], y[0], z[0]), (0.0, 0.0, 0.0), "the ground");
+        assert!((x[1], y[1]) == (0.0, 0.0));
+        assert!(
+            (z[1] as f64 - (-1.0 - sag)).abs() < 1e-4 * sag,
+            "the bob hangs at {} (declared −1, sag {sag:.3e})",
+            z[1]
+        );
     }
 
     #[test]

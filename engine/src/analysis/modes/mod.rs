@@ -121,6 +121,10 @@ pub struct ModalAnalysis {
     /// eigensolvers cannot take, or a solver that failed. The model still plays (the
     /// instrument then uses the Gershgorin clamp and the impulse pitch estimate).
     pub skipped: Option<String>,
+    /// A 3-D model's static equilibrium, where its modes are linearised (3-D spec §6.1): x, y
+    /// and z of each point, in [`Mode::shape`]'s layout, so that a mode's shape moves around
+    /// it. Empty for a 1-D model, linearised at its stage-0 positions (the engine's).
+    pub rest: Vec<f64>,
 }
 
 impl ModalAnalysis {
@@ -252,14 +256,20 @@ impl Engine {
         let eq = crate::analysis::space::equilibrium::equilibrium(self);
         let sys = crate::analysis::space::system::assemble(self, &eq.x, true);
         let (slots, sample_rate) = (3 * self.model.info.num_points, self.sample_rate_hz());
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let mut analysis = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             solve::modes(&sys, slots, sample_rate, count)
         }))
         .unwrap_or_else(|_| {
             let mut empty = solve::unsolved(&sys, sample_rate);
             empty.skipped = Some("the eigensolver failed on this model".into());
             empty
-        })
+        });
+        analysis.rest = eq.x[..self.model.info.num_points]
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
+        analysis
     }
 
     /// The reference pitch of issue 14: the frequency of the strongest mode (above 20 Hz) that

@@ -27,6 +27,7 @@ pub(super) fn unsolved(sys: &System, sample_rate: f64) -> ModalAnalysis {
         proportional: true,
         degrees_of_freedom: sys.len(),
         skipped: None,
+        rest: Vec::new(),
     }
 }
 
