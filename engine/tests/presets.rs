@@ -124,6 +124,8 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("aeolian-harp.mdl", None),
     ("celesta.mdl", None),
     // Models in space (issue 39): (points, interactions) as `ressort check` counts them.
+    ("glide-string.mdl", Some((16, 30))),
+    ("plucked-string-3d.mdl", Some((35, 67))),
     ("bowed-string-3d.mdl", Some((35, 67))),
     ("mesh-bell.mdl", Some((201, 2280))),
     ("ball-on-drum.mdl", Some((170, 625))),

@@ -100,6 +100,8 @@ pub const PRESETS: &[Preset] = presets![
     "friction-squeal",
     "rattle",
     // Models in space (~dim 3), in their categories' order.
+    "glide-string",
+    "plucked-string-3d",
     "bowed-string-3d",
     "mesh-bell",
     "ball-on-drum",
