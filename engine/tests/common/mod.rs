@@ -10,7 +10,8 @@ use ressort_engine::{compile, CompileOptions, Engine, ModelSpec};
 /// `text` parsed as a script of `models/`: an `objMesh` line reads its file from there.
 pub fn parse(text: &str) -> Parsed {
     let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
-    parse_with_files(text, &folder_files(&models))
+    let files = folder_files(&models);
+    parse_with_files(text, &files)
 }
 
 /// The spec of `text`, which must parse without errors (warnings allowed); else the test fails
