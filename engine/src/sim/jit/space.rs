@@ -42,10 +42,20 @@ mod sample;
 
 /// The most points plus interactions a 3-D model compiled to native code may have: a 3-D
 /// point is three axes of state and a 3-D link a few dozen operations, so fewer fit in
-/// registers than in 1-D ([`super::MAX_ELEMENTS`]). The `ELEMENTS` script of the tests (10
-/// points, 23 links) fits; see docs/design/simulation.md, "Native code for small models", for
-/// the measurements.
+/// registers than in 1-D ([`super::MAX_ELEMENTS`]). The `ELEMENTS` script of
+/// `tests/space_jit.rs` (10 points, 23 links of 17 laws) fits, and ran 1.5–1.8× as fast
+/// natively as on the interpreter.
 pub(crate) const MAX_SPACE_ELEMENTS: usize = 48;
+
+/// The most links of one law a 3-D model compiled to native code may have, plus one. From
+/// eight links of a law on, the interpreter evaluates that law eight links at a time on the
+/// CPU's vectors (`space::links::apply_vector`, AVX-512), and the scalar native code loses:
+/// on the build machine (AMD EPYC, AVX-512; one run each, loaded), 3-D chains of 3, 5 and 6
+/// masses (4, 6 and 7 `springDamper`s) ran 2.2×, 2.4× and 1.2× as fast natively, chains of
+/// 7, 10 and 16 masses (8, 11 and 17 links) 0.88×, 0.87× and 0.68× (`bench_small_3d_models_
+/// native_against_the_interpreter`). On AVX2 the vector path starts at four links; the
+/// crossover there is not measured.
+pub(crate) const MAX_SPACE_GROUP: usize = 8;
 
 /// Samples per trip round the loop, as in 1-D (`jit/emit.rs`).
 const UNROLL: usize = 2;
@@ -96,7 +106,8 @@ fn lengths(s: &Space) -> [usize; 8] {
 }
 
 /// Whether `e` is a 3-D model this compiles: no connection point, no audio-rate parameter,
-/// small enough, every index inside the arrays it reads.
+/// small enough (in all and per law: [`MAX_SPACE_ELEMENTS`], [`MAX_SPACE_GROUP`]), every
+/// index inside the arrays it reads.
 pub(super) fn fits(e: &Parts<'_>) -> bool {
     let Some(s) = e.space else {
         return false;
@@ -116,6 +127,7 @@ pub(super) fn fits(e: &Parts<'_>) -> bool {
         && !m.audio_directions
         && m.proxies.is_empty()
         && n + links <= MAX_SPACE_ELEMENTS
+        && m.groups.iter().all(|g| g.len() < MAX_SPACE_GROUP)
         && [ax, ay, z.x.len(), z.xp.len(), z.f.len()]
             .iter()
             .all(|&l| l == n)
