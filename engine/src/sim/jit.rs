@@ -35,6 +35,19 @@
 //! stored state), the periodic flush (calls end at flush boundaries), the motion store (an
 //! engine with one attached runs the interpreter), and the held fixed points of `rest.rs`.
 //!
+//! A small 3-D model (3-D spec §1.5; at most [`space::MAX_SPACE_ELEMENTS`] points and
+//! interactions and fewer than [`space::MAX_SPACE_GROUP`] links of any one law, no connection
+//! point, no audio-rate parameter) is compiled by `jit/space.rs` the same way, with x, x̃ and
+//! F of every point on each of the three axes in SSA values: the avatars (stage 1 a), the
+//! runs' update with its rest offset and locked axes (stage 2), every law of the 3-D table
+//! through `jit/arith.rs` on the same one source as the scalar and lane paths, the force
+//! inputs (stage 4) and the outputs, microphones included (stage 6), each in the order of
+//! `sim/space/`. It reads every derived value (the runs' A, B, 1/M, G and a, the unit
+//! directions, P⊥, the `osc` rest positions and the microphones' frozen weights) from the
+//! engine's arrays and takes no identity, so it has no bail-out and no coefficient to watch:
+//! [`NativeCode::fits`] checks only that the engine still has the model the code was made
+//! for (tests `tests/space_jit.rs`).
+//!
 //! The code lives in executable pages owned by a [`JITModule`]; the engine's copies (voices)
 //! share it through an `Arc`, and the last one frees it, off the audio thread like every
 //! engine drop. Where Cranelift has no back end for the CPU, or the system refuses executable

@@ -43,7 +43,7 @@ mod sample;
 /// The most points plus interactions a 3-D model compiled to native code may have: a 3-D
 /// point is three axes of state and a 3-D link a few dozen operations, so fewer fit in
 /// registers than in 1-D ([`super::MAX_ELEMENTS`]). The `ELEMENTS` script of
-/// `tests/space_jit.rs` (10 points, 23 links of 17 laws) fits, and ran 1.5–1.8× as fast
+/// `tests/space_jit.rs` (10 points, 23 links of 17 laws) fits, and ran 1.4–1.8× as fast
 /// natively as on the interpreter.
 pub(crate) const MAX_SPACE_ELEMENTS: usize = 48;
 
