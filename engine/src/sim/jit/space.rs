@@ -402,3 +402,70 @@ impl<'a, 'b> Emitter3<'a, 'b> {
         self.b.switch_to_block(go_on);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::{compile, parse, CompileOptions};
+
+    /// States no script starts from but a blow-up can leave (−0, NaN and infinite positions,
+    /// delayed positions and forces, huge values), poked into each axis of both engines: the
+    /// native code still gives the interpreter's bits, NaNs included, and trips the guard at
+    /// the same sample.
+    #[test]
+    fn odd_3d_states_give_the_interpreter_bits() {
+        let text = "~dim 3\n@g ground [0 0 0]\n@m mass 1. [0.1 0 0.2] [0 0 0]\n\
+                    @n osc 2. 0.01 0.001 [1 0 0] [0 0 0]\n@z massZ 1. [0 1 0] [0 0 0]\n\
+                    @l springDamper @g @m 0.1 0.001 auto\n@j contact @m @n 0.1 0.001 1.\n\
+                    @k nlBow @n @z 0.005 0.0001 1\n@in1 frcInputXYZ @m\n\
+                    @out1 posOutput @n [0 1 0]\n@out2 frcOutput @g\n@out3 velOutput @z\n";
+        let spec = parse(text).spec.expect("parses");
+        let native = compile(&spec, &CompileOptions::at(48_000.0)).expect("compiles");
+        let interpreted = compile(
+            &spec,
+            &CompileOptions {
+                jit: false,
+                ..CompileOptions::at(48_000.0)
+            },
+        )
+        .expect("compiles");
+        assert!(native.native_code_bytes().is_some());
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let values = [-0.0, f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300];
+        let mut input = vec![0.0; 24];
+        input[3] = 0.01;
+        for axis in 0..3 {
+            for point in 0..native.points.x.len() {
+                for array in 0..3 {
+                    for &value in &values {
+                        let (mut a, mut b) = (native.clone(), interpreted.clone());
+                        for e in [&mut a, &mut b] {
+                            let space = e.space.as_deref_mut().expect("a 3-D model");
+                            let p = match axis {
+                                0 => &mut space.ax,
+                                1 => &mut space.ay,
+                                _ => &mut e.points,
+                            };
+                            [&mut p.x, &mut p.xp, &mut p.f][array][point] = value;
+                        }
+                        let (mut oa, mut ob) = (vec![0.0; 24], vec![0.0; 24]);
+                        let ra = a.process(8, &input, &mut oa);
+                        let rb = b.process(8, &input, &mut ob);
+                        let at = format!("axis {axis}, point {point}, array {array}, {value:e}");
+                        assert_eq!(bits(&oa), bits(&ob), "{at}");
+                        assert_eq!(ra, rb, "{at}");
+                        assert_eq!(a.guard, b.guard, "{at}");
+                        for c in 0..3 {
+                            for k in 0..3 {
+                                assert_eq!(
+                                    bits(a.axis_state(c)[k]),
+                                    bits(b.axis_state(c)[k]),
+                                    "{at}: axis {c}, array {k}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
