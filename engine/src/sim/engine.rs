@@ -381,6 +381,20 @@ impl Engine {
         }
     }
 
+    /// The state along axis `c` (0 x, 1 y, 2 z) of every point: positions, delayed
+    /// positions and forces, in the order of [`Engine::positions`] (a 1-D model's x and y
+    /// are empty): what the differential tests compare.
+    #[doc(hidden)]
+    pub fn axis_state(&self, c: usize) -> [&[f64]; 3] {
+        let p = match (&self.space, c) {
+            (Some(s), 0) => &s.ax,
+            (Some(s), 1) => &s.ay,
+            (_, 2) => &self.points,
+            _ => return [&[], &[], &[]],
+        };
+        [&p.x, &p.xp, &p.f]
+    }
+
     /// How much the model moved: the largest |x − x̃| of any point on any axis, and of
     /// |x − last| on the z axis (`last` is updated to x; the positions' length). A voice
     /// bank frees a voice whose level stays below its threshold.
@@ -786,7 +800,7 @@ impl Engine {
 
     /// The periodic flush on every axis.
     #[inline(always)]
-    fn flush_all(&mut self) {
+    pub(crate) fn flush_all(&mut self) {
         flush_tiny(&mut self.points);
         if let Some(space) = &mut self.space {
             for axis in space.planar_axes() {

@@ -35,6 +35,19 @@
 //! stored state), the periodic flush (calls end at flush boundaries), the motion store (an
 //! engine with one attached runs the interpreter), and the held fixed points of `rest.rs`.
 //!
+//! A small 3-D model (3-D spec §1.5; at most [`space::MAX_SPACE_ELEMENTS`] points and
+//! interactions and fewer than [`space::MAX_SPACE_GROUP`] links of any one law, no connection
+//! point, no audio-rate parameter) is compiled by `jit/space.rs` the same way, with x, x̃ and
+//! F of every point on each of the three axes in SSA values: the avatars (stage 1 a), the
+//! runs' update with its rest offset and locked axes (stage 2), every law of the 3-D table
+//! through `jit/arith.rs` on the same one source as the scalar and lane paths, the force
+//! inputs (stage 4) and the outputs, microphones included (stage 6), each in the order of
+//! `sim/space/`. It reads every derived value (the runs' A, B, 1/M, G and a, the unit
+//! directions, P⊥, the `osc` rest positions and the microphones' frozen weights) from the
+//! engine's arrays and takes no identity, so it has no bail-out and no coefficient to watch:
+//! [`NativeCode::fits`] checks only that the engine still has the model the code was made
+//! for (tests `tests/space_jit.rs`).
+//!
 //! The code lives in executable pages owned by a [`JITModule`]; the engine's copies (voices)
 //! share it through an `Arc`, and the last one frees it, off the audio thread like every
 //! engine drop. Where Cranelift has no back end for the CPU, or the system refuses executable
@@ -55,6 +68,7 @@ use std::sync::{Mutex, OnceLock};
 pub(crate) mod arith;
 mod emit;
 mod sample;
+mod space;
 
 /// The most points plus interactions a model compiled to native code may have. Beyond that
 /// the state no longer fits in registers and the interpreter's vector loops win: on the Zen 3
@@ -89,6 +103,18 @@ pub(crate) struct Frame {
     pub zero: *const f64,
     /// [`SPARE`] values written by an output channel the block does not have.
     pub sink: *mut f64,
+    /// A 3-D model's x and y axes (x, x̃, F of each; its z axis is `x`, `xp`, `f`), what
+    /// its controls derive (`Space::coef` as [`RunCoef`](crate::sim::space::RunCoef)s, the
+    /// unit directions and the line avatars' P⊥ as three f64 each) and what its stage 0
+    /// froze (the `osc` rest positions, the microphones' weights and directions). Null for a
+    /// 1-D model.
+    pub axes: [[*mut f64; 3]; 2],
+    pub coef: *const f64,
+    pub units: *const f64,
+    pub perp: *const f64,
+    pub rest: *const f64,
+    pub mic_weights: *const f64,
+    pub mic_dirs: *const f64,
 }
 
 /// The most samples one call of the generated function runs, and the length of the spare
@@ -119,6 +145,8 @@ pub(crate) struct NativeCode {
     points: usize,
     args: usize,
     singles: usize,
+    /// A 3-D model's lengths the code indexes ([`space::Shape`]); `None` for a 1-D model.
+    space: Option<space::Shape>,
     /// Bytes of machine code.
     size: usize,
     /// The pages `entry` lives in; freed when the last engine copy lets go.
@@ -179,31 +207,44 @@ pub(crate) struct Parts<'a> {
     pub interactions: &'a Interactions,
     /// The bindings of the control arguments (`ControlArgs::bindings`).
     pub control_bindings: &'a [crate::sim::compiled::Binding],
+    /// A 3-D model's x and y axes and derived values; `None` for a 1-D model.
+    pub space: Option<&'a crate::sim::space::Space>,
 }
 
 /// Whether this model is one the native code compiles (its kinds and size; see the module
 /// documentation).
 pub(crate) fn fits(engine: &Parts<'_>) -> bool {
-    emit::fits(engine)
+    match engine.space {
+        Some(_) => space::fits(engine),
+        None => emit::fits(engine),
+    }
 }
 
 impl NativeCode {
     /// Compiles `engine`'s sample loop, or returns `None` when the model is not one this
     /// compiles (see the module documentation) or Cranelift fails.
     pub(crate) fn build(engine: &Parts<'_>) -> Option<NativeCode> {
-        if !emit::fits(engine) {
+        if !fits(engine) {
             return None;
         }
         // A failure anywhere in Cranelift (a back-end limit, memory protection) leaves the
         // model on its interpreter; it must never take the host down with it.
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| emit::compile(engine)))
-            .ok()
-            .flatten()
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match engine.space {
+            Some(_) => space::compile(engine),
+            None => emit::compile(engine),
+        }))
+        .ok()
+        .flatten()
     }
 
     /// Whether the code runs `engine` exactly: every mass it updates as plain is plain now,
     /// and every mass it takes as a unit mass still has 1/M = 1.
     pub(crate) fn fits(&self, engine: &Parts<'_>) -> bool {
+        if let Some(shape) = &self.space {
+            return engine.points.x.len() == self.points
+                && engine.args.len() == self.args
+                && engine.space.is_some_and(|s| shape.fits(s));
+        }
         let s = &engine.singles;
         engine.points.x.len() == self.points
             && engine.args.len() == self.args

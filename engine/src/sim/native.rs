@@ -3,7 +3,7 @@
 //! guard's record, the periodic flush, a sample the code refuses).
 
 use crate::sim::engine::{BlockIo, Engine};
-use crate::sim::flush::{flush_tiny, FLUSH_INTERVAL};
+use crate::sim::flush::FLUSH_INTERVAL;
 use crate::sim::jit;
 
 impl Engine {
@@ -36,6 +36,7 @@ impl Engine {
             proxies: &self.proxies,
             interactions: &self.interactions,
             control_bindings: &self.control.bindings,
+            space: self.space.as_deref(),
         }
     }
 
@@ -71,6 +72,7 @@ impl Engine {
             // Calls end where the periodic flush is due.
             let due = FLUSH_INTERVAL - self.samples_since_reset % FLUSH_INTERVAL;
             let stop = samples.end.min(n + due as usize);
+            let (space_axes, [coef, units, perp, rest, mic_weights, mic_dirs]) = self.space_frame();
             let frame = jit::Frame {
                 x: self.points.x.as_mut_ptr(),
                 xp: self.points.xp.as_mut_ptr(),
@@ -89,6 +91,13 @@ impl Engine {
                 sign: -0.0,
                 zero: jit::ZEROS.as_ptr(),
                 sink: sink.as_mut_ptr(),
+                axes: space_axes,
+                coef,
+                units,
+                perp,
+                rest,
+                mic_weights,
+                mic_dirs,
             };
             debug_assert!(stop - n <= jit::SPARE);
             // SAFETY: the code was made for this engine's arrays, whose lengths `fits`
@@ -118,17 +127,43 @@ impl Engine {
                 debug_assert!(false, "the native code and the guard disagree");
                 self.samples_since_reset += 1;
                 if self.samples_since_reset.is_multiple_of(FLUSH_INTERVAL) {
-                    flush_tiny(&mut self.points);
+                    self.flush_all();
                 }
                 n = done + 1;
                 continue;
             }
             self.samples_since_reset += (stop - n) as u64;
             if self.samples_since_reset.is_multiple_of(FLUSH_INTERVAL) {
-                flush_tiny(&mut self.points);
+                self.flush_all();
             }
             n = stop;
         }
         samples.end
+    }
+
+    /// A 3-D model's parts of the [`jit::Frame`]: its x and y axes (x, x̃, F) and its coef,
+    /// units, perp, rest, mic weights and mic directions; null for a 1-D model.
+    fn space_frame(&mut self) -> ([[*mut f64; 3]; 2], [*const f64; 6]) {
+        let null = std::ptr::null_mut::<f64>();
+        let mut axes = [[null; 3]; 2];
+        let Some(space) = self.space.as_deref_mut() else {
+            return (axes, [std::ptr::null(); 6]);
+        };
+        for (to, axis) in axes.iter_mut().zip(space.planar_axes()) {
+            *to = [
+                axis.x.as_mut_ptr(),
+                axis.xp.as_mut_ptr(),
+                axis.f.as_mut_ptr(),
+            ];
+        }
+        let data = [
+            space.coef.as_ptr().cast::<f64>(),
+            space.directions.units.as_ptr().cast::<f64>(),
+            space.directions.perp.as_ptr().cast::<f64>(),
+            space.rest.as_ptr().cast::<f64>(),
+            space.mic_weights.as_ptr(),
+            space.mic_dirs.as_ptr().cast::<f64>(),
+        ];
+        (axes, data)
     }
 }

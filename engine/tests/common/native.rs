@@ -135,6 +135,13 @@ pub fn native_equals_interpreter(text: &str, sr: f64, blocks: usize, seed: u64) 
             "x̃, {at}"
         );
         assert_eq!(bits(native.forces()), bits(interpreted.forces()), "F, {at}");
+        // A 3-D model's x and y axes (empty for a 1-D model).
+        for c in 0..2 {
+            let (a, b) = (native.axis_state(c), interpreted.axis_state(c));
+            for (k, name) in ["x", "x̃", "F"].iter().enumerate() {
+                assert_eq!(bits(a[k]), bits(b[k]), "{name} on axis {c}, {at}");
+            }
+        }
         assert_eq!(native.guard_event(), interpreted.guard_event(), "{at}");
     }
     native_blocks

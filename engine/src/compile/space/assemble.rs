@@ -169,6 +169,14 @@ impl<'a> Cx<'a> {
             space: Some(Box::new(Space::new(Arc::new(model)))),
         };
         engine.reset();
+        // A small 3-D model also gets its sample loop as machine code (`sim/jit/space.rs`).
+        if options.jit {
+            engine.native = crate::sim::jit::NativeCode::build(&engine.parts()).map(Arc::new);
+            engine.native_fits = engine
+                .native
+                .as_ref()
+                .is_some_and(|code| code.fits(&engine.parts()));
+        }
         Ok(engine)
     }
 }

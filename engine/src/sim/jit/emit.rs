@@ -81,6 +81,29 @@ pub(super) fn fits(engine: &Parts<'_>) -> bool {
 
 /// Compiles `engine` (which [`fits`]); `None` if Cranelift refuses it.
 pub(super) fn compile(engine: &Parts<'_>) -> Option<NativeCode> {
+    let (module, entry, size, masses) = define(|b, callees| {
+        let masses = Emitter::new(engine, b, callees).function();
+        masses
+    })?;
+    Some(NativeCode {
+        entry,
+        plain: masses.plain,
+        unit: masses.unit,
+        points: engine.points.x.len(),
+        args: engine.args.len(),
+        singles: engine.singles.len(),
+        space: None,
+        size,
+        module: Mutex::new(Some(module)),
+    })
+}
+
+/// Declares a function of [`super::Entry`]'s signature, has `body` emit it, and compiles it: the module that owns the code, the entry, the bytes
+/// of machine code and what `body` returned. `None` if Cranelift refuses it. Shared by the
+/// 1-D emitter and the 3-D one (`jit/space.rs`).
+pub(super) fn define<T>(
+    body: impl FnOnce(&mut FunctionBuilder, Callees) -> T,
+) -> Option<(JITModule, super::Entry, usize, T)> {
     let isa = super::isa()?;
     let mut module = JITModule::new(JITBuilder::with_isa(isa, default_libcall_names()));
     let call_conv = module.isa().default_call_conv();
@@ -100,13 +123,13 @@ pub(super) fn compile(engine: &Parts<'_>) -> Option<NativeCode> {
         .ok()?;
     ctx.func.name = UserFuncName::user(0, id.as_u32());
     let mut fctx = FunctionBuilderContext::new();
-    let masses = {
+    let made = {
         let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
         let callees = Callees::import(&mut b, call_conv);
-        let masses = Emitter::new(engine, &mut b, callees).function();
+        let made = body(&mut b, callees);
         b.seal_all_blocks();
         b.finalize();
-        masses
+        made
     };
     module.define_function(id, &mut ctx).ok()?;
     let size = ctx.compiled_code().map_or(0, |c| c.code_buffer().len());
@@ -119,16 +142,7 @@ pub(super) fn compile(engine: &Parts<'_>) -> Option<NativeCode> {
     // SAFETY: the function was declared with `Entry`'s signature in the target's C calling
     // convention, and lives as long as `module`, which the `NativeCode` owns.
     let entry = unsafe { std::mem::transmute::<*const u8, super::Entry>(code) };
-    Some(NativeCode {
-        entry,
-        plain: masses.plain,
-        unit: masses.unit,
-        points: engine.points.x.len(),
-        args: engine.args.len(),
-        singles: engine.singles.len(),
-        size,
-        module: Mutex::new(Some(module)),
-    })
+    Some((module, entry, size, made))
 }
 
 /// Which single masses the code updates as plain (a = 2, b = −1, g = +0) and, of those, as
@@ -354,39 +368,8 @@ impl<'a, 'b> Emitter<'a, 'b> {
         setup.masses
     }
 
-    /// Each channel's address at the call's first sample: channel c at `buffer + 8·(c·frames
-    /// + start)` when the block has it (c below its channel count), else `spare`.
     fn channels(&mut self, numbers: &[u32], start: Value, inputs: bool) -> Vec<(u32, Value)> {
-        if numbers.is_empty() {
-            return Vec::new();
-        }
-        let (buffer, count, spare) = if inputs {
-            (
-                offset_of!(Frame, inputs),
-                offset_of!(Frame, in_channels),
-                offset_of!(Frame, zero),
-            )
-        } else {
-            (
-                offset_of!(Frame, outputs),
-                offset_of!(Frame, out_channels),
-                offset_of!(Frame, sink),
-            )
-        };
-        let (buffer, count, spare) = (self.field(buffer), self.field(count), self.field(spare));
-        let frames = self.field(offset_of!(Frame, frames));
-        let first = self.b.ins().ishl_imm(start, 3);
-        let buffer = self.b.ins().iadd(buffer, first);
-        numbers
-            .iter()
-            .map(|&c| {
-                let number = self.b.ins().iconst(types::I64, c as i64);
-                let present = self.b.ins().icmp(IntCC::UnsignedLessThan, number, count);
-                let bytes = self.b.ins().imul_imm(frames, 8 * c as i64);
-                let at = self.b.ins().iadd(buffer, bytes);
-                (c, self.b.ins().select(present, at, spare))
-            })
-            .collect()
+        channels(self.b, self.frame, numbers, start, inputs)
     }
 
     pub(super) fn store_state(&mut self, x: Value, xp: Value, f: Value) {
@@ -405,7 +388,50 @@ impl<'a, 'b> Emitter<'a, 'b> {
 
 const _: () = assert!(FLUSH_INTERVAL <= super::SPARE as u64);
 
-fn sorted_unique(channels: impl Iterator<Item = u32>) -> Vec<u32> {
+/// Each channel's address at the call's first sample: channel c at `buffer + 8·(c·frames +
+/// start)` when the block has it (c below its channel count), else the frame's spare channel
+/// (`zero` for inputs, `sink` for outputs).
+pub(super) fn channels(
+    b: &mut FunctionBuilder,
+    frame: Value,
+    numbers: &[u32],
+    start: Value,
+    inputs: bool,
+) -> Vec<(u32, Value)> {
+    if numbers.is_empty() {
+        return Vec::new();
+    }
+    let (buffer, count, spare) = if inputs {
+        (
+            offset_of!(Frame, inputs),
+            offset_of!(Frame, in_channels),
+            offset_of!(Frame, zero),
+        )
+    } else {
+        (
+            offset_of!(Frame, outputs),
+            offset_of!(Frame, out_channels),
+            offset_of!(Frame, sink),
+        )
+    };
+    let mut field = |offset: usize| b.ins().load(types::I64, FLAGS, frame, offset as i32);
+    let (buffer, count, spare) = (field(buffer), field(count), field(spare));
+    let frames = field(offset_of!(Frame, frames));
+    let first = b.ins().ishl_imm(start, 3);
+    let buffer = b.ins().iadd(buffer, first);
+    numbers
+        .iter()
+        .map(|&c| {
+            let number = b.ins().iconst(types::I64, c as i64);
+            let present = b.ins().icmp(IntCC::UnsignedLessThan, number, count);
+            let bytes = b.ins().imul_imm(frames, 8 * c as i64);
+            let at = b.ins().iadd(buffer, bytes);
+            (c, b.ins().select(present, at, spare))
+        })
+        .collect()
+}
+
+pub(super) fn sorted_unique(channels: impl Iterator<Item = u32>) -> Vec<u32> {
     let mut v: Vec<u32> = channels.collect();
     v.sort_unstable();
     v.dedup();

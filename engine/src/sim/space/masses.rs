@@ -34,8 +34,10 @@ pub(crate) struct Run {
 }
 
 /// A run's coefficients: A, B, 1/M, and per axis the gravity force G and the acceleration a
-/// (both 0 on a locked axis).
+/// (both 0 on a locked axis). In C layout: the native code reads it as nine `f64`s
+/// (`jit/space.rs`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
 pub(crate) struct RunCoef {
     pub a: f64,
     pub b: f64,
