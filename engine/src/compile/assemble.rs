@@ -147,11 +147,7 @@ impl<'a> Cx<'a> {
         };
         engine.reset();
         if options.jit {
-            engine.native = crate::sim::jit::NativeCode::build(&engine.parts()).map(Arc::new);
-            engine.native_fits = engine
-                .native
-                .as_ref()
-                .is_some_and(|code| code.fits(&engine.parts()));
+            engine.attach_native_code();
         }
         Ok(engine)
     }

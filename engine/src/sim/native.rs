@@ -7,6 +7,17 @@ use crate::sim::flush::FLUSH_INTERVAL;
 use crate::sim::jit;
 
 impl Engine {
+    /// Compiles this engine's sample loop to machine code when the model is small enough
+    /// ([`jit::NativeCode::build`]; 1-D and 3-D alike), and notes whether it fits the
+    /// current state. Off the audio thread: called once when the model is compiled.
+    pub(crate) fn attach_native_code(&mut self) {
+        self.native = jit::NativeCode::build(&self.parts()).map(std::sync::Arc::new);
+        self.native_fits = self
+            .native
+            .as_ref()
+            .is_some_and(|code| code.fits(&self.parts()));
+    }
+
     /// The size in bytes of the machine code this model's sample loop runs on, when it runs on
     /// code compiled for it ([`crate::CompileOptions::jit`]: small models; see
     /// [`crate::sim::jit`]) rather than on the interpreter. Parameter changes are counted from

@@ -171,11 +171,7 @@ impl<'a> Cx<'a> {
         engine.reset();
         // A small 3-D model also gets its sample loop as machine code (`sim/jit/space.rs`).
         if options.jit {
-            engine.native = crate::sim::jit::NativeCode::build(&engine.parts()).map(Arc::new);
-            engine.native_fits = engine
-                .native
-                .as_ref()
-                .is_some_and(|code| code.fits(&engine.parts()));
+            engine.attach_native_code();
         }
         Ok(engine)
     }
