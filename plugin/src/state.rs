@@ -27,6 +27,7 @@
 use crate::model::{Compare, ModelStore};
 use nice_plug::params::persist::PersistentField;
 use nice_plug::prelude::PluginState;
+use nice_plug::REFUSED_STATE_FIELD;
 use serde_json::Value;
 use std::sync::Arc;
 
@@ -50,8 +51,9 @@ fn format_of(state: &PluginState) -> Result<u64, String> {
 
 /// Runs before nice-plug applies a state (`Plugin::filter_state`): a newer or unreadable
 /// format keeps only its format field, so that nothing else is loaded and the format field
-/// reports the refusal. Older formats need no rewriting yet: their fields default as the
-/// table above says.
+/// reports the refusal to the editor, and is marked refused ([`REFUSED_STATE_FIELD`]), so that
+/// the host's state load fails (vendor/README.md, patch 11). Older formats need no rewriting
+/// yet: their fields default as the table above says.
 pub fn filter(state: &mut PluginState) {
     match format_of(state) {
         Ok(format) if format <= STATE_FORMAT => {}
@@ -65,6 +67,13 @@ pub fn filter(state: &mut PluginState) {
                     state.fields.insert(FORMAT_FIELD.to_string(), quoted);
                 }
             }
+            let saved = state
+                .fields
+                .get(FORMAT_FIELD)
+                .and_then(|text| serde_json::from_str::<Value>(text).ok())
+                .unwrap_or(Value::Null);
+            let reason = Value::String(refusal(&saved)).to_string();
+            state.fields.insert(REFUSED_STATE_FIELD.to_string(), reason);
         }
     }
 }
@@ -160,9 +169,12 @@ mod tests {
             assert!(s.params.is_empty(), "format {format}: parameters kept");
             assert_eq!(
                 s.fields.keys().collect::<Vec<_>>(),
-                vec!["format"],
+                vec!["format", REFUSED_STATE_FIELD],
                 "format {format}"
             );
+            let reason: String = serde_json::from_str(&s.fields[REFUSED_STATE_FIELD])
+                .expect("the reason is a JSON string");
+            assert!(reason.starts_with("state: refused:"), "{reason}");
         }
     }
 

@@ -97,3 +97,5 @@ mod event_loop;
 pub use wrapper::standalone::nice_export_standalone;
 
 pub use nice_log as log;
+/// See [`wrapper::state::REFUSED_STATE_FIELD`] (Ressort patch).
+pub use wrapper::state::REFUSED_STATE_FIELD;

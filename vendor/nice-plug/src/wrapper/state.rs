@@ -119,6 +119,12 @@ pub(crate) unsafe fn serialize_json<'a, P: Plugin>(
     }
 }
 
+/// The field a plugin's [`Plugin::filter_state()`] adds to refuse a state (a newer format, say);
+/// its value, the reason as JSON text, is logged. The wrapper then loads no parameters, hands
+/// the remaining fields to [`Params::deserialize_fields()`] (so that the plugin can report the
+/// refusal), and the host's state load fails: `false` in CLAP, `kResultFalse` in VST3.
+pub const REFUSED_STATE_FIELD: &str = "nice-plug:refused";
+
 /// Deserialize a plugin's state from a [`PluginState`] object. This is used to allow the plugin to
 /// do its own internal preset management. Returns `false` and logs an error if the state could not
 /// be deserialized.
@@ -139,6 +145,15 @@ pub(crate) unsafe fn deserialize_object<P: Plugin>(
 ) -> bool {
     // This lets the plugin perform migrations on old state if needed
     P::filter_state(state);
+
+    // A plugin refuses a state by adding `REFUSED_STATE_FIELD` in `filter_state` (Ressort
+    // patch): its parameters are not touched, its remaining fields still reach
+    // `deserialize_fields` so that the plugin can say why, and the load fails to the host.
+    if let Some(reason) = state.fields.remove(REFUSED_STATE_FIELD) {
+        plugin_params.deserialize_fields(&state.fields);
+        crate::nice_warn!("The plugin refused the state: {}", reason);
+        return false;
+    }
 
     let sample_rate = current_buffer_config.map(|c| c.sample_rate);
     for (param_id_str, param_value) in &state.params {
