@@ -889,3 +889,77 @@ fn a_harder_key_on_the_felt_piano_is_brighter() {
         "the linear contact brightens by {linear_rise:.2}"
     );
 }
+
+/// Full-scale white noise, the same every run (a 64-bit LCG's high bits).
+fn white_noise(frames: usize, seed: u64) -> Vec<f32> {
+    let mut s = seed;
+    (0..frames)
+        .map(|_| {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) as f32
+        })
+        .collect()
+}
+
+/// A sidechain routed to a finger's place (an `audioParam` in a connection point's
+/// coordinate) slides the finger instead of teleporting it: full-scale noise there blew Two
+/// Fingers String up at 192 kHz (its contacts injecting energy at every jump, spec §2.8).
+#[test]
+fn noise_on_a_fingers_place_slides_it_and_trips_no_guard() {
+    for sr in [48_000.0, 192_000.0] {
+        let mut p = Player::new(&preset("two-fingers-string"), sr);
+        let noise = white_noise((1.5 * sr) as usize, 7);
+        let take = p.play(
+            Controls::DEFAULT,
+            &[(0, Event::note_on(60, 0.8))],
+            Some(&noise),
+            1.5,
+        );
+        let finite = take.channels.iter().flatten().all(|v| v.is_finite());
+        println!(
+            "two-fingers-string at {sr} Hz, noise on the fingers: peak {:.3}, {} trip(s)",
+            take.peak(),
+            take.trips
+        );
+        assert_eq!(take.trips, 0, "the guard tripped at {sr} Hz");
+        assert!(finite, "non-finite output at {sr} Hz");
+        assert!(take.peak() > 1e-3, "the note went silent at {sr} Hz");
+    }
+}
+
+/// The glide of a coordinate input: a step reaches 1 − 1/e of its height after
+/// `PLACE_GLIDE_MS`, inputs that are no coordinate take the host signal as it comes, and a
+/// host gone silent lets the coordinate glide back towards its rest.
+#[test]
+fn a_step_on_a_coordinate_input_glides_and_other_inputs_do_not() {
+    const SR: f64 = 48_000.0;
+    let script = "@f audioParam @in2\n@s string 10 1. 0.1 0.001 0. 0.\n\
+                  @in1 frcInput [@s f]\n@out1 posOutput [@s 0.5]\n";
+    let mut m = instrument::prepare("glide", script, SR).expect("it prepares");
+    let chunk = instrument::CHUNK;
+    let mut host = vec![[0.0f64; instrument::CHUNK]; MAX_HOST_INPUTS];
+    let order = ressort_engine::instrument::host::default_order(false);
+    // in1 reads sidechain left (host channel 2), in2 sidechain right (3).
+    host[2] = [0.25; instrument::CHUNK];
+    host[3] = [1.0; instrument::CHUNK];
+    let frames = (instrument::PLACE_GLIDE_MS * 1e-3 * SR) as usize;
+    let mut seen = Vec::new();
+    let mut forces = Vec::new();
+    for _ in 0..frames.div_ceil(chunk) {
+        m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);
+        forces.extend_from_slice(&m.inputs[..chunk]);
+        seen.extend_from_slice(&m.inputs[chunk..2 * chunk]);
+    }
+    let at = seen[frames - 1];
+    println!("a step of 1 on the coordinate: {at:.4} after {frames} samples");
+    assert!((at - (1.0 - (-1.0f64).exp())).abs() < 0.01, "{at}");
+    assert!(seen.windows(2).all(|w| w[1] > w[0]), "the glide rises");
+    let force = forces[0];
+    assert!(force != 0.0 && forces.iter().all(|&f| f == force), "{forces:?}");
+    // Silence: the coordinate glides back down.
+    host[3] = [0.0; instrument::CHUNK];
+    m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);
+    assert!(m.inputs[chunk..2 * chunk].iter().all(|&v| v < at));
+}

@@ -48,7 +48,9 @@ pub use gains::Gains;
 pub use host::{HostSettings, InputRole, Rejected};
 pub use load::{prepare, prepare_analysed, prepare_with};
 pub use macros::MacroBinding;
-pub use prepare::{parse_script, peak_frequency, Conventions, Facts, Prepared, Watcher};
+pub use prepare::{
+    parse_script, peak_frequency, Conventions, Facts, Prepared, Watcher, PLACE_GLIDE_MS,
+};
 
 use crate::RouteSource;
 use controls::{ClampView, Smoothed};
@@ -348,6 +350,7 @@ impl Instrument {
     pub fn reset(&mut self, controls: Controls) -> Option<Box<Prepared>> {
         if let Some(m) = self.current.as_mut() {
             m.engine.reset();
+            m.rest_inputs();
             if let Some(bank) = m.bank.as_mut() {
                 bank.clear();
             }
@@ -378,6 +381,7 @@ impl Instrument {
     pub fn restart(&mut self) {
         if let Some(m) = self.current.as_mut() {
             m.engine.reset();
+            m.rest_inputs();
             if let Some(bank) = m.bank.as_mut() {
                 bank.clear();
             }

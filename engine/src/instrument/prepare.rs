@@ -87,6 +87,41 @@ pub struct Facts {
     /// ([`super::level`]); 1 in legacy projects.
     pub output_trim: f64,
     pub input_trim: f64,
+    /// Per model input: the one-pole coefficient that smooths a host signal feeding a
+    /// connection-point coordinate (an `audioParam` named in `[@s f]`, [`PLACE_GLIDE_MS`]),
+    /// 1 for every other input, which takes the signal as it comes.
+    pub place_glide: Vec<f64>,
+}
+
+/// The time constant with which a host signal moves a connection point along its macro.
+/// A point that jumps along a string from one sample to the next injects energy (spec
+/// §2.8; issue 34 of its table): full-scale noise on a sidechain routed to a finger's place
+/// blew Two Fingers String up at 192 kHz. Smoothed to gesture speed, a sidechain still
+/// slides the finger (63 % of a step in 5 ms) and no longer teleports it. The engine, and
+/// `ressort render` without `--as-plugin`, take the audio-rate parameter raw, as the spec
+/// says.
+pub const PLACE_GLIDE_MS: f64 = 5.0;
+
+/// [`Facts::place_glide`] of a model: the coefficient for inputs that feed a coordinate.
+fn place_glide(info: &crate::ModelInfo, sample_rate: f64) -> Vec<f64> {
+    let a = 1.0 - (-1000.0 / (PLACE_GLIDE_MS * sample_rate)).exp();
+    info.inputs
+        .iter()
+        .map(|uses| {
+            let places = uses.iter().any(|u| match u {
+                InputUse::Param(name) => info
+                    .params
+                    .iter()
+                    .any(|p| p.coordinate && &p.name == name),
+                _ => false,
+            });
+            if places && a > 0.0 && a < 1.0 {
+                a
+            } else {
+                1.0
+            }
+        })
+        .collect()
 }
 
 /// A model ready to run: what its preparation found ([`Facts`], immutable) and the running
@@ -97,6 +132,9 @@ pub struct Prepared {
     pub engine: Engine,
     /// Planar input scratch, `roles.len()` channels of [`CHUNK`] samples.
     pub inputs: Vec<f64>,
+    /// Per model input, the smoothed host signal of a glided input ([`Facts::place_glide`]),
+    /// starting at its rest.
+    pub(crate) glided: Vec<f64>,
     /// Planar output scratch, `max(outputs, 1)` channels of [`CHUNK`] samples.
     pub outputs: Vec<f64>,
     /// Sees the positions after every chunk, if set.
@@ -243,7 +281,9 @@ pub(crate) fn prepare_uncalibrated(
         SampleRateMode::Raw => 1.0,
     };
     let num_outputs = info.num_outputs();
+    let place_glide = place_glide(&info, sample_rate);
     let mut facts = Facts {
+        place_glide,
         exciters,
         conventions,
         rest_out: vec![0.0; num_outputs.max(1)],
@@ -287,6 +327,7 @@ pub(crate) fn prepare_uncalibrated(
         strike_hold: 0,
         awake: conventions == Conventions::Legacy,
         inputs: vec![0.0; facts.roles.len() * CHUNK],
+        glided: facts.rest.clone(),
         outputs: vec![0.0; num_outputs.max(1) * CHUNK],
         facts: Arc::new(facts),
         engine,
@@ -533,15 +574,38 @@ impl Prepared {
                 .and_then(|c| host_in.get(c))
             {
                 Some(channel) if gain != 0.0 => {
-                    for (d, s) in dst.iter_mut().zip(&channel[..len]) {
-                        *d = rest + s * gain;
-                        fed |= *s != 0.0;
+                    let a = self.facts.place_glide[k];
+                    if a == 1.0 {
+                        for (d, s) in dst.iter_mut().zip(&channel[..len]) {
+                            *d = rest + s * gain;
+                            fed |= *s != 0.0;
+                        }
+                    } else {
+                        // A coordinate: y ← y + a·(target − y), from the rest on.
+                        let mut y = self.glided[k];
+                        for (d, s) in dst.iter_mut().zip(&channel[..len]) {
+                            let target = rest + s * gain;
+                            y += a * (target - y);
+                            *d = y;
+                            fed |= *s != 0.0;
+                        }
+                        // A non-finite host signal is no place: the glide starts again.
+                        self.glided[k] = if y.is_finite() { y } else { rest };
                     }
                 }
-                _ => dst.fill(rest),
+                _ => {
+                    dst.fill(rest);
+                    self.glided[k] = rest;
+                }
             }
         }
         fed
+    }
+
+    /// Puts the glided inputs back at their rests ([`Facts::place_glide`]): with the model's
+    /// own reset, so that a render from a reset does not depend on what came before.
+    pub(crate) fn rest_inputs(&mut self) {
+        self.glided.copy_from_slice(&self.facts.rest);
     }
 
     /// Plays `voices` notes at once: 1 is the monophonic instrument (a note retunes and strikes
