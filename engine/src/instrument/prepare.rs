@@ -694,11 +694,14 @@ impl Prepared {
         Some(self.facts.settings.reference_key + 12.0 * (top / f).log2())
     }
 
-    /// Puts the one model's gestures at rest, with no key holding them.
+    /// Puts the one model's gestures at rest, with no key holding them, and the glided host
+    /// inputs at their rests ([`Prepared::rest_inputs`]): what a level measurement's drum
+    /// left there does not reach the next performance.
     pub fn rest_gestures(&mut self) {
         self.gestures = exciters::AT_REST;
         self.held_note = None;
         self.strike_hold = 0;
+        self.rest_inputs();
     }
 
     /// Adds a one-sample strike of `velocity` (0 … 1) to the note input at `frame` of the
