@@ -99,7 +99,8 @@ pub struct Facts {
 /// blew Two Fingers String up at 192 kHz. Smoothed to gesture speed, a sidechain still
 /// slides the finger (63 % of a step in 5 ms) and no longer teleports it. The engine, and
 /// `ressort render` without `--as-plugin`, take the audio-rate parameter raw, as the spec
-/// says.
+/// says, and so do projects saved before concert pitch ([`Conventions::Legacy`]), which
+/// play as they were saved.
 pub const PLACE_GLIDE_MS: f64 = 5.0;
 
 /// [`Facts::place_glide`] of a model: the coefficient for inputs that feed a coordinate.
@@ -281,7 +282,11 @@ pub(crate) fn prepare_uncalibrated(
         SampleRateMode::Raw => 1.0,
     };
     let num_outputs = info.num_outputs();
-    let place_glide = place_glide(&info, sample_rate);
+    // Projects saved before the glide play their sidechain as they did.
+    let place_glide = match conventions {
+        Conventions::Musical => place_glide(&info, sample_rate),
+        Conventions::Legacy => vec![1.0; info.inputs.len()],
+    };
     let mut facts = Facts {
         place_glide,
         exciters,
