@@ -957,7 +957,10 @@ fn a_step_on_a_coordinate_input_glides_and_other_inputs_do_not() {
     assert!((at - (1.0 - (-1.0f64).exp())).abs() < 0.01, "{at}");
     assert!(seen.windows(2).all(|w| w[1] > w[0]), "the glide rises");
     let force = forces[0];
-    assert!(force != 0.0 && forces.iter().all(|&f| f == force), "{forces:?}");
+    assert!(
+        force != 0.0 && forces.iter().all(|&f| f == force),
+        "{forces:?}"
+    );
     // Silence: the coordinate glides back down.
     host[3] = [0.0; instrument::CHUNK];
     m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);

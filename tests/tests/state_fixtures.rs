@@ -191,10 +191,7 @@ fn a_state_of_a_newer_format_is_refused_and_the_model_keeps_playing() {
             "newer state while {}: {result:?}",
             if active { "active" } else { "inactive" }
         );
-        assert!(
-            result.is_err(),
-            "the host was told a refused state loaded"
-        );
+        assert!(result.is_err(), "the host was told a refused state loaded");
         assert_eq!(
             state::json(&victim.save_state()),
             state::json(&before),

@@ -110,10 +110,9 @@ fn place_glide(info: &crate::ModelInfo, sample_rate: f64) -> Vec<f64> {
         .iter()
         .map(|uses| {
             let places = uses.iter().any(|u| match u {
-                InputUse::Param(name) => info
-                    .params
-                    .iter()
-                    .any(|p| p.coordinate && &p.name == name),
+                InputUse::Param(name) => {
+                    info.params.iter().any(|p| p.coordinate && &p.name == name)
+                }
                 _ => false,
             });
             if places && a > 0.0 && a < 1.0 {
