@@ -966,3 +966,34 @@ fn a_step_on_a_coordinate_input_glides_and_other_inputs_do_not() {
     m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);
     assert!(m.inputs[chunk..2 * chunk].iter().all(|&v| v < at));
 }
+
+/// A coordinate gliding back to rest lands on it: after the host falls silent it reads 0
+/// exactly, never a subnormal on its way.
+#[test]
+fn a_coordinate_glides_back_to_its_rest_exactly() {
+    const SR: f64 = 48_000.0;
+    let script = "@f audioParam @in1\n@s string 10 1. 0.1 0.001 0. 0.\n\
+                  @in2 frcInput [@s f]\n@out1 posOutput [@s 0.5]\n";
+    let mut m = instrument::prepare("glide", script, SR).expect("it prepares");
+    let chunk = instrument::CHUNK;
+    let order = ressort_engine::instrument::host::default_order(false);
+    let mut host = vec![[0.0f64; instrument::CHUNK]; MAX_HOST_INPUTS];
+    host[2] = [0.7; instrument::CHUNK];
+    for _ in 0..100 {
+        m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);
+    }
+    host[2] = [0.0; instrument::CHUNK];
+    let mut last = f64::NAN;
+    for _ in 0..(2.0 * SR) as usize / chunk {
+        m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);
+        for &v in &m.inputs[..chunk] {
+            assert!(v == 0.0 || v.is_normal(), "a subnormal glide value {v:e}");
+        }
+        last = m.inputs[chunk - 1];
+    }
+    assert_eq!(
+        last.to_bits(),
+        0.0f64.to_bits(),
+        "the glide ends at {last:e}"
+    );
+}

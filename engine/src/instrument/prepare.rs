@@ -585,11 +585,15 @@ impl Prepared {
                             fed |= *s != 0.0;
                         }
                     } else {
-                        // A coordinate: y ← y + a·(target − y), from the rest on.
+                        // A coordinate: y ← y + a·(target − y), from the rest on. Within
+                        // 1e-12 of its target (of a macro's length) it lands there, so that a
+                        // glide back to rest ends at the rest's bits and never decays into
+                        // subnormal numbers.
                         let mut y = self.glided[k];
                         for (d, s) in dst.iter_mut().zip(&channel[..len]) {
                             let target = rest + s * gain;
-                            y += a * (target - y);
+                            let step = a * (target - y);
+                            y = if step.abs() < 1e-12 { target } else { y + step };
                             *d = y;
                             fed |= *s != 0.0;
                         }
