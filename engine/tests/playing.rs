@@ -929,26 +929,35 @@ fn noise_on_a_fingers_place_slides_it_and_trips_no_guard() {
     }
 }
 
+/// A model whose `@in2` is an `audioParam` that places `@in1`'s force along a string: in1
+/// reads the sidechain's left channel (host channel 2), in2 its right (3).
+fn glide_model() -> Prepared {
+    let script = "@f audioParam @in2\n@s string 10 1. 0.1 0.001 0. 0.\n\
+                  @in1 frcInput [@s f]\n@out1 posOutput [@s 0.5]\n";
+    instrument::prepare("glide", script, 48_000.0).expect("it prepares")
+}
+
+/// One chunk of the host's channels into `m`'s inputs.
+fn fill(m: &mut Prepared, host: &[[f64; instrument::CHUNK]]) {
+    let order = ressort_engine::instrument::host::default_order(false);
+    m.fill_inputs(host, order, instrument::CHUNK, 1.0, 1.0, false);
+}
+
 /// The glide of a coordinate input: a step reaches 1 − 1/e of its height after
 /// `PLACE_GLIDE_MS`, inputs that are no coordinate take the host signal as it comes, and a
 /// host gone silent lets the coordinate glide back towards its rest.
 #[test]
 fn a_step_on_a_coordinate_input_glides_and_other_inputs_do_not() {
-    const SR: f64 = 48_000.0;
-    let script = "@f audioParam @in2\n@s string 10 1. 0.1 0.001 0. 0.\n\
-                  @in1 frcInput [@s f]\n@out1 posOutput [@s 0.5]\n";
-    let mut m = instrument::prepare("glide", script, SR).expect("it prepares");
+    let mut m = glide_model();
     let chunk = instrument::CHUNK;
     let mut host = vec![[0.0f64; instrument::CHUNK]; MAX_HOST_INPUTS];
-    let order = ressort_engine::instrument::host::default_order(false);
-    // in1 reads sidechain left (host channel 2), in2 sidechain right (3).
     host[2] = [0.25; instrument::CHUNK];
     host[3] = [1.0; instrument::CHUNK];
-    let frames = (instrument::PLACE_GLIDE_MS * 1e-3 * SR) as usize;
+    let frames = (instrument::PLACE_GLIDE_MS * 1e-3 * 48_000.0) as usize;
     let mut seen = Vec::new();
     let mut forces = Vec::new();
     for _ in 0..frames.div_ceil(chunk) {
-        m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);
+        fill(&mut m, &host);
         forces.extend_from_slice(&m.inputs[..chunk]);
         seen.extend_from_slice(&m.inputs[chunk..2 * chunk]);
     }
@@ -963,7 +972,7 @@ fn a_step_on_a_coordinate_input_glides_and_other_inputs_do_not() {
     );
     // Silence: the coordinate glides back down.
     host[3] = [0.0; instrument::CHUNK];
-    m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);
+    fill(&mut m, &host);
     assert!(m.inputs[chunk..2 * chunk].iter().all(|&v| v < at));
 }
 
@@ -971,25 +980,21 @@ fn a_step_on_a_coordinate_input_glides_and_other_inputs_do_not() {
 /// exactly, never a subnormal on its way.
 #[test]
 fn a_coordinate_glides_back_to_its_rest_exactly() {
-    const SR: f64 = 48_000.0;
-    let script = "@f audioParam @in1\n@s string 10 1. 0.1 0.001 0. 0.\n\
-                  @in2 frcInput [@s f]\n@out1 posOutput [@s 0.5]\n";
-    let mut m = instrument::prepare("glide", script, SR).expect("it prepares");
+    let mut m = glide_model();
     let chunk = instrument::CHUNK;
-    let order = ressort_engine::instrument::host::default_order(false);
     let mut host = vec![[0.0f64; instrument::CHUNK]; MAX_HOST_INPUTS];
-    host[2] = [0.7; instrument::CHUNK];
+    host[3] = [0.7; instrument::CHUNK];
     for _ in 0..100 {
-        m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);
+        fill(&mut m, &host);
     }
-    host[2] = [0.0; instrument::CHUNK];
+    host[3] = [0.0; instrument::CHUNK];
     let mut last = f64::NAN;
-    for _ in 0..(2.0 * SR) as usize / chunk {
-        m.fill_inputs(&host, order, chunk, 1.0, 1.0, false);
-        for &v in &m.inputs[..chunk] {
+    for _ in 0..96_000 / chunk {
+        fill(&mut m, &host);
+        for &v in &m.inputs[chunk..2 * chunk] {
             assert!(v == 0.0 || v.is_normal(), "a subnormal glide value {v:e}");
         }
-        last = m.inputs[chunk - 1];
+        last = m.inputs[2 * chunk - 1];
     }
     assert_eq!(
         last.to_bits(),
