@@ -15,6 +15,7 @@ use crate::runtime::RuntimeStatus;
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::params::persist::PersistentField;
 use ressort_engine::instrument;
+use ressort_engine::instrument::saved_analyses;
 pub use ressort_engine::instrument::units::format_value;
 use ressort_engine::instrument::units::MacroUnit;
 use ressort_engine::instrument::ModalModel;
@@ -80,6 +81,43 @@ impl ModelState {
             script: script.into(),
             playing: Playing::Musical,
         }
+    }
+}
+
+/// A model as the state saves it: its script and, for a script the plugin does not ship, the
+/// analyses the process keeps for it, so that the project reopens without running them
+/// ([`instrument::saved_analyses`]). The JSON is [`ModelState`]'s with one more member,
+/// `analyses`, which older versions ignore.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SavedModel {
+    #[serde(flatten)]
+    pub model: ModelState,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub analyses: Option<String>,
+}
+
+impl SavedModel {
+    /// `model` with the analyses the process keeps for its script.
+    pub fn of(model: ModelState) -> SavedModel {
+        let analyses = saved_analyses::save(&model.script, model.playing.conventions());
+        SavedModel { model, analyses }
+    }
+
+    /// Hands the saved analyses to the process's memory (before the script is prepared) and
+    /// returns the model. Analyses that cannot be trusted are dropped with the reason on the
+    /// log: the script is then analysed as if none had been saved.
+    pub fn restore(self) -> ModelState {
+        if let Some(text) = &self.analyses {
+            let m = &self.model;
+            if let Err(why) = saved_analyses::restore(&m.script, m.playing.conventions(), text) {
+                nice_plug::nice_warn!(
+                    "state: the analyses saved with `{}` were not read ({why}); it is analysed \
+                     afresh",
+                    m.name
+                );
+            }
+        }
+        self.model
     }
 }
 
@@ -760,17 +798,17 @@ impl ModelStore {
     }
 }
 
-impl<'a> PersistentField<'a, ModelState> for Arc<ModelStore> {
-    fn set(&self, new_value: ModelState) {
+impl<'a> PersistentField<'a, SavedModel> for Arc<ModelStore> {
+    fn set(&self, new_value: SavedModel) {
         // A state whose script does not load keeps the running model; the diagnostics say why.
-        let _ = self.submit(new_value);
+        let _ = self.submit(new_value.restore());
     }
 
     fn map<F, R>(&self, f: F) -> R
     where
-        F: Fn(&ModelState) -> R,
+        F: Fn(&SavedModel) -> R,
     {
-        f(&lock(&self.running))
+        f(&SavedModel::of(self.running()))
     }
 }
 

@@ -7,9 +7,13 @@
 //! | field     | holds                                                          | since    |
 //! |-----------|----------------------------------------------------------------|----------|
 //! | `model`   | the running model: `name`, `script`, `playing`                 | format 0 |
+//! |           | … and `analyses`, what its analyses found (a script not shipped) | format 1 |
 //! | `cc_map`  | MIDI learn: the controller of each macro slot                  | format 0 |
-//! | `compare` | the A/B slots and which one runs                               | format 1 |
+//! | `compare` | the A/B slots (each as `model`) and which one runs             | format 1 |
 //! | `format`  | [`STATE_FORMAT`]                                               | format 1 |
+//!
+//! `analyses` came after format 1 without a new number: an older Ressort ignores it and
+//! analyses the script, as it always did (`ressort_engine::instrument::saved_analyses`).
 //!
 //! **Formats.** 0: projects saved before the state said its format (`model` without `playing`
 //! plays by the conventions of its time, [`crate::model::Playing::Legacy`]; with it, as
@@ -24,10 +28,11 @@
 //! the model store, whose diagnostics say why (the editor shows them). The running model, its
 //! parameters and the rest of the project keep playing.
 
-use crate::model::{Compare, ModelStore};
+use crate::model::{Compare, ModelStore, SavedModel};
 use nice_plug::params::persist::PersistentField;
 use nice_plug::prelude::PluginState;
 use nice_plug::REFUSED_STATE_FIELD;
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::sync::Arc;
 
@@ -36,6 +41,8 @@ pub const STATE_FORMAT: u64 = 1;
 
 /// The persisted field's key of the format.
 const FORMAT_FIELD: &str = "format";
+/// The persisted field's key of the A/B slots.
+const COMPARE_FIELD: &str = "compare";
 
 /// The format a state says it has: 0 without the field (saved before it existed).
 /// `Err` holds the field's text when it is not a format number.
@@ -52,11 +59,19 @@ fn format_of(state: &PluginState) -> Result<u64, String> {
 /// Runs before nice-plug applies a state (`Plugin::filter_state`): a newer or unreadable
 /// format keeps only its format field, so that nothing else is loaded and the format field
 /// reports the refusal to the editor, and is marked refused ([`REFUSED_STATE_FIELD`]), so that
-/// the host's state load fails (vendor/README.md, patch 11). Older formats need no rewriting
-/// yet: their fields default as the table above says.
+/// the host's state load fails (vendor/README.md, patch 11). Older formats get the one field
+/// whose absence would keep something of the instance's past: empty A/B slots; their other
+/// fields default as the table above says.
 pub fn filter(state: &mut PluginState) {
     match format_of(state) {
-        Ok(format) if format <= STATE_FORMAT => {}
+        Ok(format) if format <= STATE_FORMAT => {
+            // A project without A/B slots (format 0, saved before them) has empty ones: the
+            // slots of whatever the instance ran before are not the project's.
+            if !state.fields.contains_key(COMPARE_FIELD) {
+                let empty = serde_json::to_string(&SavedCompare::default()).unwrap_or_default();
+                state.fields.insert(COMPARE_FIELD.to_string(), empty);
+            }
+        }
         newer => {
             state.params.clear();
             state.fields.retain(|key, _| key == FORMAT_FIELD);
@@ -115,16 +130,33 @@ impl<'a> PersistentField<'a, Value> for FormatField {
 /// The persisted `compare` field: the A/B slots, saved with the project since format 1.
 pub struct CompareField(pub Arc<ModelStore>);
 
-impl<'a> PersistentField<'a, Compare> for CompareField {
-    fn set(&self, saved: Compare) {
-        self.0.restore_compare(saved);
+/// The A/B slots as the state saves them: [`Compare`]'s JSON, each slot a [`SavedModel`] with
+/// its analyses. A member missing from the JSON reads as empty.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SavedCompare {
+    pub slots: [Option<SavedModel>; 2],
+    pub active: usize,
+}
+
+impl<'a> PersistentField<'a, SavedCompare> for CompareField {
+    fn set(&self, saved: SavedCompare) {
+        let slots = saved.slots.map(|s| s.map(SavedModel::restore));
+        self.0.restore_compare(Compare {
+            slots,
+            active: saved.active,
+        });
     }
 
     fn map<F, R>(&self, f: F) -> R
     where
-        F: Fn(&Compare) -> R,
+        F: Fn(&SavedCompare) -> R,
     {
-        f(&self.0.compare())
+        let c = self.0.compare();
+        f(&SavedCompare {
+            slots: c.slots.map(|s| s.map(SavedModel::of)),
+            active: c.active,
+        })
     }
 }
 
@@ -148,7 +180,7 @@ mod tests {
     }
 
     #[test]
-    fn older_and_current_formats_pass_unchanged() {
+    fn older_and_current_formats_pass_with_empty_slots_where_they_had_none() {
         for fields in [
             vec![("model", "{}")],
             vec![("model", "{}"), ("format", "0")],
@@ -157,7 +189,14 @@ mod tests {
             let mut s = state(&fields);
             filter(&mut s);
             assert_eq!(s.params.len(), 1, "{fields:?}");
-            assert_eq!(s.fields.len(), fields.len(), "{fields:?}");
+            for (k, v) in &fields {
+                assert_eq!(s.fields.get(*k).map(String::as_str), Some(*v), "{fields:?}");
+            }
+            let slots: SavedCompare =
+                serde_json::from_str(&s.fields["compare"]).expect("the slots read");
+            if !fields.iter().any(|f| f.0 == "compare") {
+                assert_eq!(slots, SavedCompare::default(), "{fields:?}");
+            }
         }
     }
 
@@ -189,22 +228,19 @@ mod tests {
         let other = ModelState::new(p.id, p.text);
         let stale = ModelState::new("stale", "@m mass 1. 0. 0.\n");
         let field = CompareField(store.clone());
-        field.set(Compare {
-            slots: [Some(other.clone()), Some(stale)],
+        field.set(SavedCompare {
+            slots: [Some(other.clone()), Some(stale)].map(|s| s.map(SavedModel::of)),
             active: 1,
         });
         let saved = field.map(|c| c.clone());
         assert_eq!(saved.active, 1);
-        assert_eq!(
-            saved.slots[1].as_ref(),
-            Some(&running),
-            "B is the running model"
-        );
-        assert_eq!(saved.slots[0].as_ref(), Some(&other));
+        let model = |slot: usize| saved.slots[slot].as_ref().map(|s| &s.model);
+        assert_eq!(model(1), Some(&running), "B is the running model");
+        assert_eq!(model(0), Some(&other));
         store.switch_compare().expect("A loads");
         assert_eq!(store.running(), other);
         // A slot number from nowhere reads as A.
-        field.set(Compare {
+        field.set(SavedCompare {
             slots: [None, None],
             active: 7,
         });

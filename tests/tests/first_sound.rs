@@ -121,3 +121,168 @@ fn every_preset_sounds_in_the_first_block_after_its_state_load() {
     let onset = own_onset("Custom", &edited);
     assert_eq!((first.blocks, again.blocks), (onset, onset));
 }
+
+/// The environment variable that makes [`a_project_reopens_with_its_scripts_analyses`] the
+/// child process: state files to reopen, separated by `;`.
+const REOPEN_ENV: &str = "RESSORT_REOPEN_STATES";
+/// The preset whose edited script the reopen test saves (harmonic-oscillator unless set:
+/// `RESSORT_REOPEN_PRESET=string-1000` shows what a large model saves).
+const REOPEN_PRESET_ENV: &str = "RESSORT_REOPEN_PRESET";
+
+/// A C4 for half a second from a loaded state: the peak and the FNV-1a hash of its bits.
+fn reopen_phrase(plugin: &mut TestPlugin) -> (f32, u64) {
+    let r = plugin.render(0.5, BLOCK, &Score::new().note_on(0, 60, 0.8));
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for s in r.audio.samples() {
+        for b in s.to_bits().to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    (r.audio.peak(), h)
+}
+
+/// The child's part: each state in a fresh instance of a fresh process (no analysis kept in
+/// its memory), loaded while active, as a DAW switching projects does.
+fn reopen(path: &str) -> String {
+    let blob = std::fs::read(path).expect("the saved state");
+    let mut plugin = TestPlugin::new();
+    plugin.activate(SR, 1, BLOCK as u32);
+    let t0 = Instant::now();
+    plugin.load_state(&blob).expect("the saved state loads");
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let (peak, hash) = reopen_phrase(&mut plugin);
+    plugin.deactivate();
+    format!("reopened {load_ms} {peak} {hash:016x}")
+}
+
+/// A user's own script is analysed the first time it loads, and the project saves what the
+/// analyses found with it: reopened in a new process, it plays the same bits without
+/// analysing again. That the saved analyses are the ones used shows in a copy whose output
+/// trim was halved (it plays at half the level); a copy from a build with other analyses (its
+/// fingerprint) and one whose trim is not a number are analysed afresh.
+#[test]
+fn a_project_reopens_with_its_scripts_analyses() {
+    if let Ok(files) = std::env::var(REOPEN_ENV) {
+        for f in files.split(';') {
+            println!("{}", reopen(f));
+        }
+        return;
+    }
+    let preset = std::env::var(REOPEN_PRESET_ENV).unwrap_or("harmonic-oscillator".into());
+    let text = presets()
+        .into_iter()
+        .find(|p| p.0 == preset)
+        .unwrap_or_else(|| panic!("no preset {preset}"))
+        .1;
+    let edited = format!("{text}\n# a user's own copy\n");
+    let mut plugin = TestPlugin::new();
+    plugin.activate(SR, 1, BLOCK as u32);
+    let blob = state::with_musical_model(&plugin.save_state(), "Custom", &edited);
+    let t0 = Instant::now();
+    plugin.load_state(&blob).expect("the edited script loads");
+    let first_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let here = reopen_phrase(&mut plugin);
+    let saved = plugin.save_state();
+    plugin.deactivate();
+
+    let mut v = state::json(&saved).expect("a state");
+    let model: serde_json::Value =
+        serde_json::from_str(v["fields"]["model"].as_str().expect("a model")).expect("JSON");
+    let analyses = model["analyses"]
+        .as_str()
+        .expect("the saved model carries its analyses")
+        .to_string();
+    assert!(analyses.starts_with("fingerprint "), "{analyses}");
+    let with_analyses = |v: &mut serde_json::Value, text: String| {
+        let mut m = model.clone();
+        m["analyses"] = serde_json::Value::String(text);
+        v["fields"]["model"] = serde_json::Value::String(m.to_string());
+        state::blob_from(v)
+    };
+    let trims = analyses
+        .lines()
+        .find(|l| l.starts_with("trims "))
+        .expect("a trims line");
+    let words: Vec<&str> = trims.split_whitespace().collect();
+    let out: f64 = words[1].parse().expect("the output trim");
+    let halved = analyses.replace(trims, &format!("trims {:?} {}", out / 2.0, words[2]));
+    let stale = format!("fingerprint 0000000000000000\n{}", {
+        let (_, rest) = analyses.split_once('\n').expect("more lines");
+        rest
+    });
+    let not_a_number = analyses.replace(trims, &format!("trims NaN {}", words[2]));
+    let blobs = [
+        saved.clone(),
+        with_analyses(&mut v, halved),
+        with_analyses(&mut v, stale),
+        with_analyses(&mut v, not_a_number),
+    ];
+    let dir = std::env::temp_dir().join(format!("ressort-reopen-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary folder");
+    let files: Vec<String> = blobs
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let f = dir.join(format!("state-{i}.bin"));
+            std::fs::write(&f, b).expect("writes the state");
+            f.to_string_lossy().into_owned()
+        })
+        .collect();
+    let out = std::process::Command::new(std::env::current_exe().expect("the test binary"))
+        .args([
+            "a_project_reopens_with_its_scripts_analyses",
+            "--exact",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env(REOPEN_ENV, files.join(";"))
+        .output()
+        .expect("runs the child");
+    let _ = std::fs::remove_dir_all(&dir);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<(f64, f32, String)> = stdout
+        .lines()
+        .filter_map(|l| l.split_once("reopened ").map(|(_, row)| row))
+        .map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            (
+                w[0].parse().unwrap(),
+                w[1].parse().unwrap(),
+                w[2].to_string(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        rows.len(),
+        4,
+        "the child printed\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let here_hash = format!("{:016x}", here.1);
+    println!(
+        "edited {preset}: first load {first_ms:.1} ms (analysed); reopened in a new process \
+         {:.1} ms (saved analyses), {:.1} ms (stale fingerprint), {:.1} ms (a NaN trim)",
+        rows[0].0, rows[2].0, rows[3].0
+    );
+    println!(
+        "peak {} here, reopened {} (hash {} / {})",
+        here.0, rows[0].1, here_hash, rows[0].2
+    );
+    assert_eq!(
+        rows[0].2, here_hash,
+        "the reopened project plays the same bits"
+    );
+    let ratio = f64::from(rows[1].1) / f64::from(here.0);
+    println!("a halved saved trim plays at {ratio:.4} of the level");
+    assert!(
+        (ratio - 0.5).abs() < 0.01,
+        "the saved trim is the one used: {ratio}"
+    );
+    for (row, what) in [(&rows[2], "a stale fingerprint"), (&rows[3], "a NaN trim")] {
+        let r = f64::from(row.1) / f64::from(here.0);
+        assert!(
+            (r - 1.0).abs() < 1e-3,
+            "{what} is analysed afresh: level {r}"
+        );
+    }
+}

@@ -72,6 +72,30 @@ fn fields(blob: &[u8]) -> serde_json::Map<String, Value> {
         .collect()
 }
 
+/// The parsed fields without the analyses saved with the model and the A/B slots.
+fn strip_analyses(fields: &mut serde_json::Map<String, Value>) {
+    if let Some(m) = fields.get_mut("model").and_then(Value::as_object_mut) {
+        m.remove("analyses");
+    }
+    if let Some(slots) = fields
+        .get_mut("compare")
+        .and_then(|c| c.get_mut("slots"))
+        .and_then(Value::as_array_mut)
+    {
+        for slot in slots.iter_mut().filter_map(Value::as_object_mut) {
+            slot.remove("analyses");
+        }
+    }
+}
+
+/// A saved project's fields and parameters, without the analyses saved with its scripts
+/// (those of a script analysed since the save come along when it is saved again).
+fn project(blob: &[u8]) -> (serde_json::Map<String, Value>, Value) {
+    let mut f = fields(blob);
+    strip_analyses(&mut f);
+    (f, state::json(blob).expect("a state")["params"].clone())
+}
+
 #[test]
 fn a_fixture_saved_again_keeps_its_model_parameters_bindings_and_slots() {
     for (stem, json, _) in fixtures::committed() {
@@ -81,7 +105,10 @@ fn a_fixture_saved_again_keeps_its_model_parameters_bindings_and_slots() {
         plugin.activate(fixtures::SAMPLE_RATE, 1, fixtures::BLOCK as u32);
         plugin.deactivate();
         let again = plugin.save_state();
-        let (before, after) = (fields(&old), fields(&again));
+        let (before, mut after) = (fields(&old), fields(&again));
+        // A script the plugin does not ship is saved again with its analyses (the
+        // `analyses` member, new since these fixtures): the rest is as it was.
+        strip_analyses(&mut after);
         for key in ["model", "cc_map", "compare"] {
             if let Some(saved) = before.get(key) {
                 assert_eq!(after.get(key), Some(saved), "{stem}: field {key}");
@@ -193,8 +220,8 @@ fn a_state_of_a_newer_format_is_refused_and_the_model_keeps_playing() {
         );
         assert!(result.is_err(), "the host was told a refused state loaded");
         assert_eq!(
-            state::json(&victim.save_state()),
-            state::json(&before),
+            project(&victim.save_state()),
+            project(&before),
             "the refused state changed the project"
         );
     }

@@ -203,12 +203,37 @@ fn lock_memory() -> std::sync::MutexGuard<'static, VecDeque<Kept>> {
     MEMORY.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// Every analysis the process keeps in memory for a script under the conventions, one per
+/// sample rate (what a project saves with the script: [`super::saved_analyses`]).
+pub(crate) fn kept_in_memory(text: &str, conventions: Conventions) -> Vec<(f64, Arc<Analyses>)> {
+    lock_memory()
+        .iter()
+        .filter(|e| e.conventions == conventions && e.text == text)
+        .map(|e| (f64::from_bits(e.rate), Arc::clone(&e.analyses)))
+        .collect()
+}
+
+/// Forgets the analyses kept in memory for a script, at every rate and under every
+/// convention, as a new process would not have them: for tests of what a project brings.
+#[doc(hidden)]
+pub fn forget(text: &str) {
+    lock_memory().retain(|e| e.text != text);
+}
+
+/// The text of `models/analyses.txt`.
+const SHIPPED_TEXT: &str = include_str!("../../../models/analyses.txt");
+
 /// The table shipped in `models/analyses.txt`.
 pub fn shipped() -> &'static Table {
     static SHIPPED: OnceLock<Table> = OnceLock::new();
-    SHIPPED.get_or_init(|| {
-        Table::parse(include_str!("../../../models/analyses.txt")).unwrap_or_default()
-    })
+    SHIPPED.get_or_init(|| Table::parse(SHIPPED_TEXT).unwrap_or_default())
+}
+
+/// The hash of the shipped table's text: it changes whenever a law, an analysis or a preset
+/// changed what the table says (its test fails until it is written again), so analyses saved
+/// by a build with another fingerprint are not trusted ([`super::saved_analyses`]).
+pub fn fingerprint() -> u64 {
+    text_hash(SHIPPED_TEXT)
 }
 
 /// One entry of a table: which script and rate it is for.

@@ -35,6 +35,7 @@ pub mod meshes;
 pub mod output;
 pub mod pitch;
 pub mod prepare;
+pub mod saved_analyses;
 pub mod trigger;
 pub mod units;
 pub mod vary;
