@@ -23,7 +23,8 @@
 //!    corrected until the two peaks agree within 2 dB (at most four more renders).
 //!
 //! A render is at most [`SECONDS`] long, shortened for large models to [`WORK_BUDGET`]
-//! element-steps (the 150 × 150 plate gets 3,000 samples, its peak comes after about 1,400). A
+//! element-steps but a note's never below [`NOTE_MIN_SECONDS`] (the 150 × 150 plate gets 3,000
+//! samples at 48 kHz, its peak comes after about 1,400, and 11,520 at 192 kHz). A
 //! model silent from the note takes its level from the drum; a model silent from both keeps
 //! 0 dB.
 
@@ -50,6 +51,11 @@ pub const NOTE_LEVEL_SECONDS: f64 = 2.0;
 const DRUM_SECONDS: f64 = 0.3;
 /// Element-steps (points + interactions, times samples) a render may take.
 pub const WORK_BUDGET: f64 = 2e8;
+/// The shortest note render, whatever [`WORK_BUDGET`] says: a struck model's peak comes a
+/// time after the note, not a number of samples (the 150 × 150 plate's hammer meets the
+/// plate some 29 ms after it; the budget alone gave it 15 ms at 192 kHz, which measured
+/// silence and took the trim from the drum, 74 dB too quiet).
+pub const NOTE_MIN_SECONDS: f64 = 0.06;
 /// The output gain the renders are measured at, far below the soft ceiling's knee.
 const MEASURE_GAIN_DB: f64 = -60.0;
 /// The trims stay within these (linear).
@@ -65,7 +71,7 @@ pub fn calibrate(p: Prepared) -> Prepared {
     let size = (p.engine.info().num_points + p.engine.info().num_interactions).max(1) as f64;
     let budget = (WORK_BUDGET / size).max(1.0);
     let sr = p.facts.sample_rate;
-    let note_frames = (SECONDS * sr).min(budget) as usize;
+    let note_frames = (SECONDS * sr).min(budget.max(NOTE_MIN_SECONDS * sr)) as usize;
     // A kick lasts about 0.3 s: its window is not shortened below a quarter second.
     let drum_frames = (DRUM_SECONDS * sr).min(budget.max(0.25 * sr)) as usize;
     let (p1, note) = peak(p, note_frames, true, None);
