@@ -152,9 +152,15 @@ impl<'a> PersistentField<'a, SavedCompare> for CompareField {
     where
         F: Fn(&SavedCompare) -> R,
     {
+        // The running slot's analyses are the `model` field's: only the other slot's are
+        // saved here (a load takes the running slot from `model` too).
         let c = self.0.compare();
+        let mut slots = c.slots.map(|s| s.map(SavedModel::of));
+        if let Some(running) = slots.get_mut(c.active).and_then(Option::as_mut) {
+            running.analyses = None;
+        }
         f(&SavedCompare {
-            slots: c.slots.map(|s| s.map(SavedModel::of)),
+            slots,
             active: c.active,
         })
     }

@@ -123,7 +123,7 @@ fn every_preset_sounds_in_the_first_block_after_its_state_load() {
 }
 
 /// The environment variable that makes [`a_project_reopens_with_its_scripts_analyses`] the
-/// child process: state files to reopen, separated by `;`.
+/// child process: the state file to reopen.
 const REOPEN_ENV: &str = "RESSORT_REOPEN_STATES";
 /// The preset whose edited script the reopen test saves (harmonic-oscillator unless set:
 /// `RESSORT_REOPEN_PRESET=string-1000` shows what a large model saves).
@@ -162,10 +162,8 @@ fn reopen(path: &str) -> String {
 /// fingerprint) and one whose trim is not a number are analysed afresh.
 #[test]
 fn a_project_reopens_with_its_scripts_analyses() {
-    if let Ok(files) = std::env::var(REOPEN_ENV) {
-        for f in files.split(';') {
-            println!("{}", reopen(f));
-        }
+    if let Ok(file) = std::env::var(REOPEN_ENV) {
+        println!("{}", reopen(&file));
         return;
     }
     let preset = std::env::var(REOPEN_PRESET_ENV).unwrap_or("harmonic-oscillator".into());
@@ -193,6 +191,13 @@ fn a_project_reopens_with_its_scripts_analyses() {
         .expect("the saved model carries its analyses")
         .to_string();
     assert!(analyses.starts_with("fingerprint "), "{analyses}");
+    let compare: serde_json::Value =
+        serde_json::from_str(v["fields"]["compare"].as_str().expect("the slots")).expect("JSON");
+    let active = compare["active"].as_u64().expect("the running slot") as usize;
+    assert!(
+        compare["slots"][active].get("analyses").is_none(),
+        "the running slot's analyses are the model's, saved once"
+    );
     let with_analyses = |v: &mut serde_json::Value, text: String| {
         let mut m = model.clone();
         m["analyses"] = serde_json::Value::String(text);
@@ -228,23 +233,32 @@ fn a_project_reopens_with_its_scripts_analyses() {
             f.to_string_lossy().into_owned()
         })
         .collect();
-    let out = std::process::Command::new(std::env::current_exe().expect("the test binary"))
-        .args([
-            "a_project_reopens_with_its_scripts_analyses",
-            "--exact",
-            "--nocapture",
-            "--test-threads=1",
-        ])
-        .env(REOPEN_ENV, files.join(";"))
-        .output()
-        .expect("runs the child");
-    let _ = std::fs::remove_dir_all(&dir);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let rows: Vec<(f64, f32, String)> = stdout
-        .lines()
-        .filter_map(|l| l.split_once("reopened ").map(|(_, row)| row))
-        .map(|l| {
-            let w: Vec<&str> = l.split_whitespace().collect();
+    // Each state in a process of its own, as a DAW opening the project anew.
+    let rows: Vec<(f64, f32, String)> = files
+        .iter()
+        .map(|f| {
+            let out = std::process::Command::new(std::env::current_exe().expect("the test binary"))
+                .args([
+                    "a_project_reopens_with_its_scripts_analyses",
+                    "--exact",
+                    "--nocapture",
+                    "--test-threads=1",
+                ])
+                .env(REOPEN_ENV, f)
+                .output()
+                .expect("runs the child");
+            let stdout = String::from_utf8_lossy(&out.stdout);
+            let row = stdout
+                .lines()
+                .find_map(|l| l.split_once("reopened ").map(|(_, row)| row))
+                .unwrap_or_else(|| {
+                    panic!(
+                        "the child printed\n{stdout}\n{}",
+                        String::from_utf8_lossy(&out.stderr)
+                    )
+                })
+                .to_string();
+            let w: Vec<&str> = row.split_whitespace().collect();
             (
                 w[0].parse().unwrap(),
                 w[1].parse().unwrap(),
@@ -252,12 +266,7 @@ fn a_project_reopens_with_its_scripts_analyses() {
             )
         })
         .collect();
-    assert_eq!(
-        rows.len(),
-        4,
-        "the child printed\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let _ = std::fs::remove_dir_all(&dir);
     let here_hash = format!("{:016x}", here.1);
     println!(
         "edited {preset}: first load {first_ms:.1} ms (analysed); reopened in a new process \
