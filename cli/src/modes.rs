@@ -7,6 +7,10 @@ use ressort_engine::modes::{note_frequency, note_name, ModalAnalysis, Solver, St
 use ressort_engine::{Engine, ScaleClass};
 use std::path::PathBuf;
 
+/// The residual (relative to the typical force) below which a static equilibrium Newton did
+/// not converge on is still reported as found.
+const NEAR_EQUILIBRIUM: f64 = 1e-6;
+
 #[derive(Args, Debug)]
 pub(crate) struct ModesArgs {
     /// The model script.
@@ -166,8 +170,15 @@ pub(crate) fn modes(a: &ModesArgs) -> Result<(), Failure> {
         analysis.modes.len()
     );
     if let Some(eq) = engine.static_equilibrium() {
+        // Newton stalls a little above its tolerance where a law has a kink at the rest it
+        // seeks (a rope stretched by exactly its load, engaged only when ℓ > L): a residual
+        // of a millionth of the typical force still places every point far closer than the
+        // modes can tell.
         let how = if eq.converged {
             "found"
+        } else if eq.residual <= NEAR_EQUILIBRIUM {
+            "found to within its residual (Newton stalled above its 1e-12 tolerance, as at a \
+             rope's kink)"
         } else {
             "NOT found (linearised at the best point reached)"
         };
