@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod native;
+pub mod player;
 
 use realfft::RealFftPlanner;
 use ressort_engine::lang::{folder_files, parse_with_files, Parsed};
