@@ -155,10 +155,17 @@ impl<'a> PersistentField<'a, SavedCompare> for CompareField {
         // The running slot's analyses are the `model` field's: only the other slot's are
         // saved here (a load takes the running slot from `model` too).
         let c = self.0.compare();
-        let mut slots = c.slots.map(|s| s.map(SavedModel::of));
-        if let Some(running) = slots.get_mut(c.active).and_then(Option::as_mut) {
-            running.analyses = None;
-        }
+        let slots = [0, 1].map(|i| {
+            let model = c.slots[i].clone()?;
+            Some(if i == c.active {
+                SavedModel {
+                    model,
+                    analyses: None,
+                }
+            } else {
+                SavedModel::of(model)
+            })
+        });
         f(&SavedCompare {
             slots,
             active: c.active,
