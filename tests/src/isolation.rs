@@ -22,12 +22,7 @@ pub fn run_isolated(test_name: &str) -> bool {
     if std::env::var(CHILD_ENV).as_deref() == Ok(test_name) {
         return true;
     }
-    let exe = std::env::current_exe().expect("the test binary's path");
-    let output = std::process::Command::new(exe)
-        .args([test_name, "--exact", "--nocapture", "--test-threads=1"])
-        .env(CHILD_ENV, test_name)
-        .output()
-        .expect("spawn the isolated test");
+    let output = run_child(test_name, CHILD_ENV, test_name);
     let stdout = String::from_utf8_lossy(&output.stdout);
     print!("{stdout}");
     // The child's stderr can hold thousands of plugin log lines: keep its head, its tail
@@ -83,4 +78,16 @@ pub(crate) fn describe_exit(status: &std::process::ExitStatus) -> String {
         }
     }
     format!("{status}")
+}
+
+/// Runs the test `test_name` of this test binary alone in a child process, with the
+/// environment variable `var` set to `value` (how the child knows what to do), and returns what
+/// it printed.
+pub fn run_child(test_name: &str, var: &str, value: &str) -> std::process::Output {
+    let exe = std::env::current_exe().expect("the test binary's path");
+    std::process::Command::new(exe)
+        .args([test_name, "--exact", "--nocapture", "--test-threads=1"])
+        .env(var, value)
+        .output()
+        .expect("spawn the child test")
 }

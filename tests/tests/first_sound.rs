@@ -237,16 +237,11 @@ fn a_project_reopens_with_its_scripts_analyses() {
     let rows: Vec<(f64, f32, String)> = files
         .iter()
         .map(|f| {
-            let out = std::process::Command::new(std::env::current_exe().expect("the test binary"))
-                .args([
-                    "a_project_reopens_with_its_scripts_analyses",
-                    "--exact",
-                    "--nocapture",
-                    "--test-threads=1",
-                ])
-                .env(REOPEN_ENV, f)
-                .output()
-                .expect("runs the child");
+            let out = ressort_tests::run_child(
+                "a_project_reopens_with_its_scripts_analyses",
+                REOPEN_ENV,
+                f,
+            );
             let stdout = String::from_utf8_lossy(&out.stdout);
             let row = stdout
                 .lines()

@@ -109,22 +109,12 @@ fn every_preset_instance_stays_lean() {
         measure(&name, &text);
         return;
     }
-    let exe = std::env::current_exe().expect("the test binary");
     println!("| preset | live (MB) | peak (MB) |");
     println!("|---|---:|---:|");
     let mut over = Vec::new();
     let edited = ANALYSED.map(|id| format!("{id}{EDITED}"));
     for name in presets.iter().map(|p| &p.0).chain(&edited) {
-        let out = std::process::Command::new(&exe)
-            .args([
-                "every_preset_instance_stays_lean",
-                "--exact",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env(PRESET_ENV, name)
-            .output()
-            .expect("runs the child");
+        let out = ressort_tests::run_child("every_preset_instance_stays_lean", PRESET_ENV, name);
         let stdout = String::from_utf8_lossy(&out.stdout);
         let line = stdout
             .lines()
