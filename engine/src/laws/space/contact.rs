@@ -12,7 +12,7 @@
 //! negative), C = Z·uuᵀ when engaged, else open; the friction counts in the damping bound.
 
 use super::table::{col, len, SpaceRow, K, N, Z};
-use super::vector::{central_block, dot, friction, norm, scale, sub};
+use super::vector::{central_block, dot, friction, map3, norm, scale, sub};
 use super::{Arith, Ends, Linear3, SpaceLaw, V3};
 use crate::laws::Law;
 
@@ -56,7 +56,7 @@ impl SpaceLaw for Contact {
                     |a| {
                         let u = scale(a, a.select(a.gt(q, zero), a.div(a.num(1.0), l), zero), d);
                         let h = friction(a, e.dv(a), u, f, zt, mu);
-                        [0, 1, 2].map(|c| a.add(g[c], h[c]))
+                        map3(|c| a.add(g[c], h[c]))
                     },
                     |_| g,
                 )

@@ -37,7 +37,7 @@ mod vdamper;
 
 pub(crate) use table::SpaceLawVisitor;
 pub use table::{ColShape, SpaceColumn, SpaceRow};
-pub(crate) use vector::{unit, Ends, V3};
+pub(crate) use vector::{map3, unit, Ends, V3};
 
 use super::Arith;
 

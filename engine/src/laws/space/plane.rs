@@ -9,7 +9,7 @@
 //! Analyses: one endpoint; at rest, engaged: K·n̂n̂ᵀ and Z·n̂n̂ᵀ (plus Zt across), else open.
 
 use super::table::{col, dir, SpaceRow, K, N, Z};
-use super::vector::{dot, friction, norm, scale};
+use super::vector::{dot, friction, map3, norm, scale};
 use super::{unit, Arith, Block, Ends, Linear3, SpaceLaw, V3};
 
 /// The plane contact.
@@ -49,7 +49,7 @@ impl SpaceLaw for PlaneContact {
                     a.gt(zt, zero),
                     |a| {
                         let h = friction(a, w, n, f_n, zt, mu);
-                        [0, 1, 2].map(|c| a.add(g[c], h[c]))
+                        map3(|c| a.add(g[c], h[c]))
                     },
                     |_| g,
                 )

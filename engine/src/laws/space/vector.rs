@@ -6,6 +6,15 @@ use crate::laws::Arith;
 /// A 3-vector (x, y, z).
 pub(crate) type V3<F> = [F; 3];
 
+/// `[f(0), f(1), f(2)]`, always inlined. The laws' vector steps are written with it rather
+/// than `array::map`, which goes through `try_map`: where the compiler left that outlined,
+/// it was compiled without the caller's instruction set, and every SIMD operation in its
+/// closure became a call (a vector damper's Δv cost some 3× a whole spring on AVX2).
+#[inline(always)]
+pub(crate) fn map3<T>(mut f: impl FnMut(usize) -> T) -> V3<T> {
+    [f(0), f(1), f(2)]
+}
+
 /// The two endpoints of an interaction at one step: positions and delayed positions (3-D
 /// spec §1.2, §1.3). A one-endpoint law reads endpoint 1 only.
 #[derive(Clone, Copy, Debug)]
@@ -20,19 +29,19 @@ impl<F: Copy> Ends<F> {
     /// d = x₁ − x₂ (3-D spec §2.2 step 1).
     #[inline(always)]
     pub fn d<A: Arith<F = F>>(&self, a: &A) -> V3<F> {
-        [0, 1, 2].map(|c| a.sub(self.x1[c], self.x2[c]))
+        map3(|c| a.sub(self.x1[c], self.x2[c]))
     }
 
     /// d̃ = x̃₁ − x̃₂.
     #[inline(always)]
     pub fn dp<A: Arith<F = F>>(&self, a: &A) -> V3<F> {
-        [0, 1, 2].map(|c| a.sub(self.xp1[c], self.xp2[c]))
+        map3(|c| a.sub(self.xp1[c], self.xp2[c]))
     }
 
     /// Δv = (x₁ − x̃₁) − (x₂ − x̃₂) (3-D spec §1.3).
     #[inline(always)]
     pub fn dv<A: Arith<F = F>>(&self, a: &A) -> V3<F> {
-        [0, 1, 2].map(|c| {
+        map3(|c| {
             a.sub(
                 a.sub(self.x1[c], self.xp1[c]),
                 a.sub(self.x2[c], self.xp2[c]),
@@ -43,7 +52,7 @@ impl<F: Copy> Ends<F> {
     /// Endpoint 1's own velocity x₁ − x̃₁ (the one-endpoint laws).
     #[inline(always)]
     pub fn v1<A: Arith<F = F>>(&self, a: &A) -> V3<F> {
-        [0, 1, 2].map(|c| a.sub(self.x1[c], self.xp1[c]))
+        map3(|c| a.sub(self.x1[c], self.xp1[c]))
     }
 }
 
@@ -59,7 +68,7 @@ pub(crate) fn dot<A: Arith>(a: &A, u: V3<A::F>, v: V3<A::F>) -> A::F {
 /// s·v.
 #[inline(always)]
 pub(crate) fn scale<A: Arith>(a: &A, s: A::F, v: V3<A::F>) -> V3<A::F> {
-    v.map(|c| a.mul(s, c))
+    map3(|c| a.mul(s, v[c]))
 }
 
 /// v / |v|, or 0 for a zero (or non-finite) vector: a direction argument (3-D spec §1.7),
@@ -69,7 +78,7 @@ pub(crate) fn scale<A: Arith>(a: &A, s: A::F, v: V3<A::F>) -> V3<A::F> {
 pub(crate) fn unit<A: Arith>(a: &A, v: V3<A::F>) -> V3<A::F> {
     let n = a.sqrt(dot(a, v, v));
     let ok = a.gt(n, a.num(0.0));
-    v.map(|c| a.select(ok, a.div(c, n), a.num(0.0)))
+    map3(|c| a.select(ok, a.div(v[c], n), a.num(0.0)))
 }
 
 /// The common evaluation of an unconditional central law (3-D spec §2.2): d, q, ℓ = √q,
@@ -140,7 +149,7 @@ pub(crate) fn friction<A: Arith>(
 ) -> V3<A::F> {
     let zero = a.num(0.0);
     let wn = dot(a, w, n);
-    let vt = [0, 1, 2].map(|c| a.sub(w[c], a.mul(wn, n[c])));
+    let vt = map3(|c| a.sub(w[c], a.mul(wn, n[c])));
     let tau = a.sqrt(dot(a, vt, vt));
     let phi = a.mul(zt, tau);
     let cap = a.mul(mu, a.abs(f_normal));

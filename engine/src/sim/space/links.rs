@@ -8,7 +8,7 @@
 //! link's own `auto`) step 1, an explicit line's every slot step 1.
 
 use super::super::kernels::Points;
-use crate::laws::space::{Ends, SpaceLaw, SpaceLawKind, SpaceLawVisitor};
+use crate::laws::space::{map3, Ends, SpaceLaw, SpaceLawKind, SpaceLawVisitor};
 use crate::laws::Scalar;
 use crate::sim::lanes::Native;
 use pulp::Simd;
@@ -166,10 +166,10 @@ fn apply_vector<L: SpaceLaw, S: Simd>(
                 && b0 + w <= v.n;
             let e = if chain {
                 Ends {
-                    x1: [0, 1, 2].map(|c| load(&v.x[c][a0..])),
-                    xp1: [0, 1, 2].map(|c| load(&v.xp[c][a0..])),
-                    x2: [0, 1, 2].map(|c| load(&v.x[c][b0..])),
-                    xp2: [0, 1, 2].map(|c| load(&v.xp[c][b0..])),
+                    x1: map3(|c| load(&v.x[c][a0..])),
+                    xp1: map3(|c| load(&v.xp[c][a0..])),
+                    x2: map3(|c| load(&v.x[c][b0..])),
+                    xp2: map3(|c| load(&v.xp[c][b0..])),
                 }
             } else {
                 // Endpoint coordinates: x₁, x̃₁, x₂, x̃₂ on each axis, lane k the link i + k.
@@ -185,10 +185,10 @@ fn apply_vector<L: SpaceLaw, S: Simd>(
                     }
                 }
                 Ends {
-                    x1: [0, 1, 2].map(|c| load(&ends[c])),
-                    xp1: [3, 4, 5].map(|c| load(&ends[c])),
-                    x2: [6, 7, 8].map(|c| load(&ends[c])),
-                    xp2: [9, 10, 11].map(|c| load(&ends[c])),
+                    x1: map3(|c| load(&ends[c])),
+                    xp1: map3(|c| load(&ends[3 + c])),
+                    x2: map3(|c| load(&ends[6 + c])),
+                    xp2: map3(|c| load(&ends[9 + c])),
                 }
             };
             let mut p = shared;
