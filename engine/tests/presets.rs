@@ -36,7 +36,7 @@ fn preset(name: &str) -> ModelSpec {
         .iter()
         .find(|f| f.0 == name)
         .unwrap_or_else(|| panic!("models/{name} is missing"));
-    // A preset in space may import a mesh of models/ (Mesh Bell's bell.obj).
+    // A preset in space may import a mesh of models/ (Mesh Bell's bell-coarse.obj).
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../models");
     let parsed = parse_with_files(text, &folder_files(&dir));
     let errors: Vec<String> = parsed.errors().map(|d| d.to_string()).collect();
@@ -127,7 +127,7 @@ const COUNTS: &[(&str, Option<(usize, usize)>)] = &[
     ("glide-string.mdl", Some((16, 30))),
     ("plucked-string-3d.mdl", Some((35, 67))),
     ("bowed-string-3d.mdl", Some((35, 67))),
-    ("mesh-bell.mdl", Some((201, 2280))),
+    ("mesh-bell.mdl", Some((61, 324))),
     ("ball-on-drum.mdl", Some((170, 625))),
     ("rope-and-plate.mdl", Some((88, 375))),
     ("pendulum-chain.mdl", Some((7, 12))),

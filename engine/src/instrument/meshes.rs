@@ -3,7 +3,13 @@
 //! in its project), so the meshes a preset needs travel inside the program, as the presets do.
 
 /// The shipped meshes, by the file name a script writes.
-const SHIPPED: [(&str, &str); 1] = [("bell.obj", include_str!("../../../models/bell.obj"))];
+const SHIPPED: [(&str, &str); 2] = [
+    ("bell.obj", include_str!("../../../models/bell.obj")),
+    (
+        "bell-coarse.obj",
+        include_str!("../../../models/bell-coarse.obj"),
+    ),
+];
 
 /// The file `path` of the shipped meshes (a path ending in a shipped file's name, such as
 /// `models/bell.obj`, finds it too).
