@@ -5,7 +5,8 @@
 //! Analyses: C = Z·I; bound Z.
 
 use super::table::{col, SpaceRow, Z};
-use super::{map3, Arith, Block, Ends, Linear3, SpaceLaw, V3};
+use super::vector::scale;
+use super::{Arith, Block, Ends, Linear3, SpaceLaw, V3};
 
 /// The vector damper.
 pub(crate) struct Vdamper;
@@ -21,9 +22,7 @@ impl SpaceLaw for Vdamper {
 
     #[inline(always)]
     fn force<A: Arith>(a: &A, e: &Ends<A::F>, p: impl Fn(usize) -> A::F) -> V3<A::F> {
-        let z = p(0);
-        let dv = e.dv(a);
-        map3(|c| a.mul(z, dv[c]))
+        scale(a, p(0), e.dv(a))
     }
 
     fn linearise(p: &[f64], _x1: [f64; 3], _x2: [f64; 3]) -> Linear3 {
