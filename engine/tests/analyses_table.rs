@@ -90,8 +90,8 @@ fn play(model: Prepared, sr: f64) -> Vec<u32> {
 /// At 48 kHz (the other rates take a minute and a half more; the example's check mode
 /// compares them all), on two threads: each preset analysed afresh (the macro units without
 /// a budget, as the table holds them) agrees with the shipped entry, to the last bits the
-/// processor's SIMD width moves ([`AGREEMENT`]; on the machine that wrote the table they are
-/// equal), and the model loaded from kept analyses plays the analysed model's samples.
+/// processor's SIMD width moves, and the rounding of a fresh pitch ([`AGREEMENT`]; the entries
+/// written before pitches were rounded keep their unrounded pitch), and the model loaded from kept analyses plays the analysed model's samples.
 #[test]
 fn the_shipped_table_equals_a_fresh_analysis_and_plays_its_samples() {
     let sr = 48000.0;

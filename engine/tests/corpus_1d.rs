@@ -83,6 +83,14 @@ fn instrument_digest(name: &str, text: &str) -> u64 {
 /// commit before the 3-D engine. 14 of the 178 renders are silent within their 4096 frames (a
 /// bow or a falling hammer that has not spoken yet; the digest of silence is 0xeb05052ea5b62325):
 /// they still pin the output's length and its silence.
+///
+/// Eight instrument digests of mi-gen legacy scripts (coupled-strings-bowed, drunk-triangles-xl,
+/// harmonic-oscillator, mesh-15x15, mesh-25x20, nonlinear-oscillator, oscillator-bank,
+/// rolling-mesh) were recorded again when analysed reference pitches began to be rounded to 20
+/// bits of mantissa ([`ressort_engine::instrument::pitch::settle_pitch`]): those scripts have no
+/// shipped analyses, and their pitch's last bits followed the processor's SIMD width, so two
+/// of their digests differed between an AVX2 and an AVX-512 machine. Their bare-engine digests,
+/// and every digest of `models/` (played by the shipped analyses), are 2caca8a's.
 const DIGESTS: &[(&str, u64, u64)] = &[
     (
         "legacy/bowed-oscillator",
@@ -107,7 +115,7 @@ const DIGESTS: &[(&str, u64, u64)] = &[
     (
         "legacy/coupled-strings-bowed",
         0xeb05052ea5b62325,
-        0x7b781df500a0a8a4,
+        0x93b606e1fe496152,
     ),
     (
         "legacy/drunk-triangles",
@@ -117,7 +125,7 @@ const DIGESTS: &[(&str, u64, u64)] = &[
     (
         "legacy/drunk-triangles-xl",
         0x5199d4910c75c4e9,
-        0x8eee9eadf37a9319,
+        0x344dcab49a15f2b9,
     ),
     (
         "legacy/fretted-string",
@@ -137,20 +145,20 @@ const DIGESTS: &[(&str, u64, u64)] = &[
     (
         "legacy/harmonic-oscillator",
         0xd48459edd5dbfa2e,
-        0xd0674cfddc2ccd85,
+        0x6ca0997525b609c5,
     ),
-    ("legacy/mesh-15x15", 0x8f6955bf94ec2325, 0xe058556bb11d54ed),
-    ("legacy/mesh-25x20", 0x8f6955bf94ec2325, 0x9b79d2e5528f4c8d),
+    ("legacy/mesh-15x15", 0x8f6955bf94ec2325, 0xfb2e9495298138ed),
+    ("legacy/mesh-25x20", 0x8f6955bf94ec2325, 0x4b6a5fc78d643751),
     ("legacy/nofx-drone", 0xeb05052ea5b62325, 0x67aaa3e61f74f774),
     (
         "legacy/nonlinear-oscillator",
         0x7fb876e6ba8552f7,
-        0xd516c8cacb10f25c,
+        0xf7e3cc2883b955f1,
     ),
     (
         "legacy/oscillator-bank",
         0xbd334b583e6e13e5,
-        0x7d2b3e31e992f33d,
+        0x2134541348c89fa3,
     ),
     (
         "legacy/plucked-harmonics",
@@ -170,7 +178,7 @@ const DIGESTS: &[(&str, u64, u64)] = &[
     (
         "legacy/rolling-mesh",
         0x8a4b67d77598f9b6,
-        0x1c08b95440eb7e6a,
+        0xe93c0fe927bbc125,
     ),
     ("legacy/string-1000", 0x8f6955bf94ec2325, 0x6307939c72928bd5),
     (

@@ -73,11 +73,17 @@ fn play(script: &str, events: &[(u32, Event)], sidechain: Option<&[f32]>) -> u64
 }
 
 /// (preset, digest of C4 then G4, digest of the kick) as played before the change.
+///
+/// Eight note digests (chladni-150x150, fretted-string, harmonic-oscillator, mesh-15x15,
+/// mesh-25x20, oscillator-bank, rolling-mesh, string-1000) were taken again when analysed
+/// reference pitches began to be rounded to 20 bits of mantissa (`instrument::pitch::
+/// settle_pitch`, at most 0.83 thousandths of a cent), so that a project tunes alike on every
+/// processor; the kick digests did not move.
 const DIGESTS: &[(&str, u64, u64)] = &[
     ("bowed-oscillator", 0x3dccfc48fb05e91e, 0xb8f680f29b85bea3),
     ("bowed-string", 0x5eac53d274f9ef25, 0x1800fd53d3f3e0bb),
     ("brokendown-string", 0xc505b9459d8b24c5, 0x4143d25d9944028e),
-    ("chladni-150x150", 0x78cd14442051eab9, 0x2fba98005daf963d),
+    ("chladni-150x150", 0xbf71a9b4cb263965, 0x2fba98005daf963d),
     (
         "coupled-strings-bowed",
         0xdd8bea797cc1cbda,
@@ -85,28 +91,28 @@ const DIGESTS: &[(&str, u64, u64)] = &[
     ),
     ("drunk-triangles", 0x6f384fc0214b3636, 0x9e0e20c433de5354),
     ("drunk-triangles-xl", 0x236aa5aae42f771f, 0x025ae94911a077cc),
-    ("fretted-string", 0x997a28d2b0b37e38, 0x434f746563b1c5c7),
+    ("fretted-string", 0x4d37c46c719ec086, 0x434f746563b1c5c7),
     ("gravity-oscillator", 0x6f384fc0214b3636, 0x9e0e20c433de5354),
     ("hammer-oscillator", 0x098b678c26f23bff, 0xc43ab8f35dec6f3b),
     (
         "harmonic-oscillator",
-        0x14480de28473def5,
+        0x58b6b9c2e552984d,
         0xf17b610a073b2921,
     ),
-    ("mesh-15x15", 0xb43074cb659ae7e1, 0x069a245250554739),
-    ("mesh-25x20", 0xb774fc0560a643bd, 0x0e80f6fc7f6abc61),
+    ("mesh-15x15", 0x0ed6c9d65963a31d, 0x069a245250554739),
+    ("mesh-25x20", 0x4b9f0839a8da15c5, 0x0e80f6fc7f6abc61),
     ("nofx-drone", 0xe0f97bc5dad4addd, 0x07d9cdd4fc3280de),
     (
         "nonlinear-oscillator",
         0x9394aa925b723bc3,
         0x8258b77b061bfbf5,
     ),
-    ("oscillator-bank", 0xd3ecc2d1412879fd, 0x699d14bbbb5cf041),
+    ("oscillator-bank", 0x00df3cec65ae79a4, 0x699d14bbbb5cf041),
     ("plucked-harmonics", 0x5eac53d274f9ef25, 0xcb5e5062a908cf11),
     ("plucked-oscillator", 0x3dccfc48fb05e91e, 0xa216a8864d047336),
     ("resonant-strings", 0x5eac53d274f9ef25, 0xe1889bfacd4e0b7d),
-    ("rolling-mesh", 0x7c3d2235526739fb, 0x5eac53d274f9ef25),
-    ("string-1000", 0xeb9de548c9c8a73d, 0x65b0896d83a8aebd),
+    ("rolling-mesh", 0x4c0926e3e27ea76f, 0x5eac53d274f9ef25),
+    ("string-1000", 0xff444e8802d0784d, 0x65b0896d83a8aebd),
     ("struck-string", 0x2d1955a2eab4e031, 0xef364e4432d539e5),
     ("two-fingers-string", 0x5eac53d274f9ef25, 0x39dc84d9aa16a2d8),
 ];

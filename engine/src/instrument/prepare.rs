@@ -8,7 +8,7 @@ use super::exciters::{self, Exciter, Gestures};
 use super::host::{HostSettings, InputRole, Rejected};
 use super::macros::{macro_bindings, MacroBinding};
 pub use super::pitch::{concert_key, peak_frequency, reference_mode};
-use super::pitch::{musical_reference_pitch, reference_pitch};
+use super::pitch::{musical_reference_pitch, reference_pitch, settle_pitch};
 use super::units::{unit_of, MacroUnit};
 use super::voices::VoiceBank;
 use super::CHUNK;
@@ -361,7 +361,9 @@ fn analyse(
             Conventions::Musical => {
                 musical_reference_pitch(spec, engine, note_input, exciters, roles, sample_rate)
             }
-        };
+        }
+        // The same on every processor, so a bounce does not depend on the machine.
+        .map(settle_pitch);
     }
     // Concert pitch: the key whose equal-tempered pitch (A4 = 440 Hz; the A4 control moves
     // every key together) is the model's reference pitch. An unpitched model keeps its own
