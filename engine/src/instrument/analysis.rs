@@ -144,7 +144,10 @@ mod tests {
         let delta = 0.5f64.powi(crate::instrument::pitch::PITCH_BITS as i32 + 1);
         let bound = 2.0 * delta * x.sin().powi(2) / (2.0 * x).cos();
         let ratio = octave / base;
-        assert!((ratio - 2.0).abs() <= bound * (1.0 + 1e-3) + 1e-12, "{ratio} (bound {bound:e})");
+        assert!(
+            (ratio - 2.0).abs() <= bound * (1.0 + 1e-3) + 1e-12,
+            "{ratio} (bound {bound:e})"
+        );
 
         // The macro slot at its top reads k = 0.02.
         let mut c = controls();

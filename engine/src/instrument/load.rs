@@ -26,6 +26,7 @@ pub fn prepare_with(
         Some(kept) => Source::Known(kept),
         None => Source::Analyse {
             units_budget_s: UNITS_BUDGET_S,
+            pitch: None,
         },
     };
     let (prepared, source) = prepare_uncalibrated(name, text, sample_rate, conventions, source)?;
@@ -52,12 +53,31 @@ pub fn prepare_analysed(
     conventions: Conventions,
     units_budget_s: f64,
 ) -> Result<Prepared, Rejected> {
+    prepare_analysed_at_pitch(name, text, sample_rate, conventions, units_budget_s, None)
+}
+
+/// [`prepare_analysed`] with the reference pitch given (`Some`) rather than analysed: every
+/// other analysis runs at that pitch (the concert key, the level calibration's tuned note).
+/// The shipped table keeps the pitches it was written with, unrounded
+/// ([`super::pitch::settle_pitch`] rounds a fresh one); its test compares a fresh analysis
+/// with it at its own pitch, and the pitches apart.
+pub fn prepare_analysed_at_pitch(
+    name: &str,
+    text: &str,
+    sample_rate: f64,
+    conventions: Conventions,
+    units_budget_s: f64,
+    pitch: Option<f64>,
+) -> Result<Prepared, Rejected> {
     let (prepared, _) = prepare_uncalibrated(
         name,
         text,
         sample_rate,
         conventions,
-        Source::Analyse { units_budget_s },
+        Source::Analyse {
+            units_budget_s,
+            pitch,
+        },
     )?;
     Ok(finish(prepared, conventions))
 }

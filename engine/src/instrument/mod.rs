@@ -47,7 +47,7 @@ pub use controls::Controls;
 pub use events::{Event, Timed};
 pub use gains::Gains;
 pub use host::{HostSettings, InputRole, Rejected};
-pub use load::{prepare, prepare_analysed, prepare_with};
+pub use load::{prepare, prepare_analysed, prepare_analysed_at_pitch, prepare_with};
 pub use macros::MacroBinding;
 pub use prepare::{
     parse_script, peak_frequency, Conventions, Facts, Prepared, Watcher, PLACE_GLIDE_MS,

@@ -197,8 +197,13 @@ pub enum Conventions {
 /// Where a preparation takes its analyses' results from.
 #[derive(Clone, Debug)]
 pub(crate) enum Source {
-    /// Runs them, measuring the macro units for at most this long.
-    Analyse { units_budget_s: f64 },
+    /// Runs them, measuring the macro units for at most this long; with `pitch`, the
+    /// reference pitch is taken as that instead of analysed (the shipped table's test
+    /// compares the rest of an analysis at the table's own pitch).
+    Analyse {
+        units_budget_s: f64,
+        pitch: Option<f64>,
+    },
     /// Kept from an earlier preparation of the same script ([`super::analyses`]); a result
     /// that does not fit the compiled script (a stale table) is analysed afresh.
     Known(Arc<Analyses>),
@@ -263,9 +268,15 @@ pub(crate) fn prepare_uncalibrated(
     });
 
     let mut settings = settings;
+    if let Source::Analyse {
+        pitch: Some(pitch), ..
+    } = source
+    {
+        settings.reference_pitch_hz = Some(pitch);
+    }
     let found = match source {
         Source::Known(ref kept) => (**kept).clone(),
-        Source::Analyse { units_budget_s } => analyse(
+        Source::Analyse { units_budget_s, .. } => analyse(
             &spec,
             &mut engine,
             &mut settings,
@@ -319,6 +330,7 @@ pub(crate) fn prepare_uncalibrated(
             conventions,
             Source::Analyse {
                 units_budget_s: UNITS_BUDGET_S,
+                pitch: None,
             },
         );
     }
