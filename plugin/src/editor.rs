@@ -442,6 +442,16 @@ impl EditorApp {
         egui::CollapsingHeader::new("Stability")
             .default_open(true)
             .show(ui, |ui| {
+                if s.provisional {
+                    ui.colored_label(
+                        ORANGE,
+                        RichText::new(
+                            "Analysing: playing on quick limits (the Gershgorin clamp, an \
+                             estimated pitch and level) until the exact analyses are done",
+                        )
+                        .small(),
+                    );
+                }
                 if s.stability.is_empty() {
                     ui.label("No mass is loaded.");
                 }

@@ -8,7 +8,7 @@
 //! old one back to be freed off the audio thread. Host gains (Stiffness, Damping, Tune, MIDI
 //! pitch) are clamped to what the model's stability analysis allows.
 
-use model::{ModelStore, Prepared};
+use model::{ModelStore, Prepared, Refinement};
 use nice_plug::midi::{Channel, Key, VoiceID};
 use nice_plug::prelude::*;
 use ressort_engine::instrument::events::Modulated;
@@ -78,6 +78,9 @@ pub struct Ressort {
     has_main_input: bool,
     /// Models waiting to go back to the store when its return channel was full.
     held: [Option<Box<Prepared>>; 4],
+    /// Exact facts waiting for their provisional model to arrive (`exact` set), or facts
+    /// waiting to go back to the store (`exact` the replaced ones).
+    refinement: Option<Refinement>,
     quiet_samples: u64,
     /// A strike from the editor waits for the next block.
     pending_strike: bool,
@@ -135,6 +138,7 @@ impl Default for Ressort {
             sample_rate: 48_000.0,
             has_main_input: false,
             held: [None, None, None, None],
+            refinement: None,
             quiet_samples: 0,
             pending_strike: false,
             voices_task_queued: false,
@@ -211,6 +215,34 @@ impl Ressort {
             .running_generation
             .fetch_add(1, Ordering::AcqRel);
         context.execute_gui(MainThreadTask::ModelChanged);
+    }
+
+    /// Hands a provisional model the facts of its exact analyses when they come
+    /// ([`Instrument::refine`]), and the replaced facts back to the store. Exact facts that
+    /// come before their model (still in the store's channel) wait for it. Realtime-safe.
+    fn refine_model(&mut self) {
+        let Some(mut r) = self
+            .refinement
+            .take()
+            .or_else(|| self.store.receive_refinement())
+        else {
+            return;
+        };
+        if let Some(exact) = r.exact.take() {
+            if !self.instrument.plays(&r.provisional) && self.store.model_waiting() {
+                r.exact = Some(exact);
+                self.refinement = Some(r);
+                return;
+            }
+            let back = self.instrument.refine(&r.provisional, exact);
+            if Arc::ptr_eq(&back, &r.provisional) {
+                self.runtime().refinements.fetch_add(1, Ordering::AcqRel);
+            }
+            r.exact = Some(back);
+        }
+        if let Err(back) = self.store.return_refinement(r) {
+            self.refinement = Some(back);
+        }
     }
 
     /// The parameters as the instrument's controls.
@@ -500,7 +532,9 @@ impl Plugin for Ressort {
         self.sample_rate = sr;
         self.has_main_input = audio_io_layout.main_input_channels.is_some();
         self.held = Default::default();
-        let Some(model) = self.store.activate(sr) else {
+        self.refinement = None;
+        let offline = buffer_config.process_mode == ProcessMode::Offline;
+        let Some(model) = self.store.activate(sr, offline) else {
             return false;
         };
         self.instrument = Instrument::new(sr, self.controls());
@@ -523,6 +557,7 @@ impl Plugin for Ressort {
         // Dropped here, on the host's main thread, not on the audio thread.
         drop(self.instrument.take_models());
         self.held = Default::default();
+        self.refinement = None;
         self.store.deactivate();
     }
 
@@ -534,6 +569,7 @@ impl Plugin for Ressort {
     ) -> ProcessStatus {
         let started = std::time::Instant::now();
         self.receive_models(context);
+        self.refine_model();
         self.editor_requests();
         self.instrument.set_watching(self.editor_state.is_open());
         let frames = buffer.samples();

@@ -8,6 +8,11 @@
 //! through a bounded lock-free channel and sends the replaced model back through another one,
 //! so it never allocates or frees. A script with errors never replaces the running model; its
 //! diagnostics are kept in [`ModelStore::status`] for the editor.
+//!
+//! A script whose analyses are not kept plays at once on provisional facts in a realtime
+//! host, and takes its exact analyses when a thread of the store has run them ([`refine`]).
+
+mod refine;
 
 use crate::motion::{motion_channel, MotionReader};
 use crate::param_text;
@@ -20,7 +25,7 @@ pub use ressort_engine::instrument::units::format_value;
 use ressort_engine::instrument::units::MacroUnit;
 use ressort_engine::instrument::ModalModel;
 pub use ressort_engine::instrument::{
-    parse_script, peak_frequency, HostSettings, InputRole, LoadLine, MacroBinding, Prepared,
+    parse_script, peak_frequency, Facts, HostSettings, InputRole, LoadLine, MacroBinding, Prepared,
     Rejected, StabilityEnvelope, CHUNK, NUM_MACROS, STABILITY_HEADROOM,
 };
 use ressort_engine::InputUse;
@@ -31,6 +36,8 @@ pub const MAX_VOICES: usize = 128;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
+
+pub use refine::Refinement;
 
 /// How a saved model is played ([`instrument::Conventions`]), as the state stores it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -132,12 +139,26 @@ pub fn prepare(
     voices: usize,
     playing: Playing,
 ) -> Result<(Prepared, MotionReader), Rejected> {
-    let mut prepared = instrument::prepare_with(name, text, sample_rate, playing.conventions())?;
-    let declared = prepared.facts().settings.voices.unwrap_or(1) as usize;
-    prepared.set_voices(if voices == 0 { declared } else { voices });
+    let prepared = instrument::prepare_with(name, text, sample_rate, playing.conventions())?;
+    Ok(with_voices_and_motion(prepared, sample_rate, voices))
+}
+
+/// A prepared model with its voices (`voices` as [`prepare`] takes it) and a motion channel.
+fn with_voices_and_motion(
+    mut prepared: Prepared,
+    sample_rate: f64,
+    voices: usize,
+) -> (Prepared, MotionReader) {
+    set_voices(&mut prepared, voices);
     let (writer, reader) = motion_channel(&prepared.engine, sample_rate);
     prepared.watcher = Some(Box::new(writer));
-    Ok((prepared, reader))
+    (prepared, reader)
+}
+
+/// Gives a prepared model its voices: `voices` as [`prepare`] takes it.
+fn set_voices(prepared: &mut Prepared, voices: usize) {
+    let declared = prepared.facts().settings.voices.unwrap_or(1) as usize;
+    prepared.set_voices(if voices == 0 { declared } else { voices });
 }
 
 /// A model's description for the editor and the tests: counts and analysis, made when it
@@ -172,6 +193,8 @@ pub struct ModelSummary {
     pub input_trim_db: f64,
     /// What a key plays: `bow in1`, `strike in2`, … (empty: nothing but a voice of its own).
     pub exciters: Vec<String>,
+    /// The model plays on provisional facts while its exact analyses run ([`refine`]).
+    pub provisional: bool,
 }
 
 /// The result of a script submission.
@@ -252,6 +275,7 @@ pub fn summary(prepared: &Prepared) -> ModelSummary {
                     .map(|k| format!("strike in{}", k + 1)),
             )
             .collect(),
+        provisional: prepared.facts().provisional,
     }
 }
 
@@ -305,6 +329,18 @@ pub struct ModelStore {
     generation: AtomicU64,
     to_audio: (Sender<Box<Prepared>>, Receiver<Box<Prepared>>),
     garbage: (Sender<Box<Prepared>>, Receiver<Box<Prepared>>),
+    /// Exact facts for the audio thread's provisional model, and the ones it gives back.
+    to_refine: (Sender<Refinement>, Receiver<Refinement>),
+    refined: (Sender<Refinement>, Receiver<Refinement>),
+    /// Models handed to the audio thread (sent, or returned by an activation), so that a
+    /// provisional model's exact analyses are dropped once another model replaced it.
+    handed: AtomicU64,
+    /// Whether the host renders offline ([`ModelStore::activate`]): models are then prepared
+    /// in full before they play.
+    offline: AtomicBool,
+    /// Held by the thread running a provisional model's exact analyses, so that one runs at
+    /// a time and those of models replaced meanwhile are skipped.
+    refining: Mutex<()>,
     /// The motion reader of the newest model sent to the audio thread, until the editor
     /// takes it.
     motion: Mutex<Option<MotionReader>>,
@@ -344,6 +380,11 @@ impl Default for ModelStore {
             generation: AtomicU64::new(0),
             to_audio: crossbeam_channel::bounded(4),
             garbage: crossbeam_channel::bounded(64),
+            to_refine: crossbeam_channel::bounded(4),
+            refined: crossbeam_channel::bounded(16),
+            handed: AtomicU64::new(0),
+            offline: AtomicBool::new(false),
+            refining: Mutex::new(()),
             motion: Mutex::new(None),
             compare: Mutex::new(Compare::default()),
             preparing: Mutex::new(()),
@@ -443,9 +484,10 @@ impl ModelStore {
         self.generation.load(Ordering::Acquire)
     }
 
-    /// Frees models the audio thread has finished with.
+    /// Frees models and facts the audio thread has finished with.
     pub fn collect_garbage(&self) {
         while self.garbage.1.try_recv().is_ok() {}
+        while self.refined.1.try_recv().is_ok() {}
     }
 
     /// Sets the running script from outside the audio thread: a state load, the editor, a
@@ -453,7 +495,7 @@ impl ModelStore {
     /// thread, which crossfades to it; while inactive it is only checked, and
     /// [`ModelStore::activate`] compiles it. A script with errors changes nothing but the
     /// diagnostics.
-    pub fn submit(&self, state: ModelState) -> Result<(), Rejected> {
+    pub fn submit(self: &Arc<Self>, state: ModelState) -> Result<(), Rejected> {
         self.submissions.fetch_add(1, Ordering::AcqRel);
         let _preparing = lock(&self.preparing);
         self.submit_prepared(state)
@@ -484,12 +526,19 @@ impl ModelStore {
                 *newest = (ticket, Some(loaded));
             }
         };
+        self.spawn_joined("ressort-load", job);
+        ticket
+    }
+
+    /// Runs `job` on a thread of its own named `name`, joined by [`ModelStore::finish_loads`];
+    /// here, on the calling thread, when no thread can be had.
+    fn spawn_joined(&self, name: &str, job: impl FnOnce() + Send + 'static) {
         // The job is kept where a failed spawn leaves it, to run here instead.
         let job = Arc::new(Mutex::new(Some(job)));
         let spawned = {
             let job = Arc::clone(&job);
             std::thread::Builder::new()
-                .name("ressort-load".into())
+                .name(name.into())
                 .spawn(move || run_once(&job))
         };
         match spawned {
@@ -498,10 +547,8 @@ impl ModelStore {
                 loads.retain(|t| !t.is_finished());
                 loads.push(thread);
             }
-            // No thread to be had: prepare here, as `submit` does.
             Err(_) => run_once(&job),
         }
-        ticket
     }
 
     /// Plays a preset or script the user chose (the editor's browser, a host's preset load),
@@ -536,7 +583,7 @@ impl ModelStore {
     }
 
     /// [`ModelStore::submit`], with `preparing` held by the caller.
-    fn submit_prepared(&self, state: ModelState) -> Result<(), Rejected> {
+    fn submit_prepared(self: &Arc<Self>, state: ModelState) -> Result<(), Rejected> {
         self.collect_garbage();
         let rate = f64::from_bits(self.sample_rate.load(Ordering::Acquire));
         // This model gets the Voices setting as it stands now, so a setting that changed
@@ -544,15 +591,9 @@ impl ModelStore {
         // the watch must not prepare the model again and cut the notes it plays. A setting
         // that changes from here on marks it stale again.
         let was_stale = rate > 0.0 && self.voices_stale.swap(false, Ordering::AcqRel);
+        let voices = self.voices();
         let result = if rate > 0.0 {
-            prepare(
-                &state.name,
-                &state.script,
-                rate,
-                self.voices(),
-                state.playing,
-            )
-            .map(Some)
+            self.prepare_for_audio(&state, rate, voices).map(Some)
         } else {
             parse_script(&state.script).map(|_| None)
         };
@@ -573,7 +614,11 @@ impl ModelStore {
                     status.stability_pending = true;
                     drop(status);
                     *lock(&self.motion) = Some(reader);
+                    let provisional = p.facts().provisional.then(|| p.shared_facts());
                     self.send(Box::new(p));
+                    if let Some(facts) = provisional {
+                        self.refine_in_background(state.clone(), rate, voices, facts);
+                    }
                 }
                 let mut compare = lock(&self.compare);
                 let active = compare.active;
@@ -649,7 +694,7 @@ impl ModelStore {
 
     /// Re-prepares the running script with the current Voices setting (any thread but the
     /// audio thread; a no-op while inactive or when nothing changed).
-    pub fn apply_voices(&self) {
+    pub fn apply_voices(self: &Arc<Self>) {
         if !self.voices_stale() {
             return;
         }
@@ -674,7 +719,7 @@ impl ModelStore {
     /// Runs the other A/B slot: its script, or a copy of the running one when it is empty
     /// (so B starts where A is). A slot whose script no longer loads keeps the running model
     /// and reports why.
-    pub fn switch_compare(&self) -> Result<(), Rejected> {
+    pub fn switch_compare(self: &Arc<Self>) -> Result<(), Rejected> {
         self.submissions.fetch_add(1, Ordering::AcqRel);
         let _preparing = lock(&self.preparing);
         let running = self.running();
@@ -719,8 +764,11 @@ impl ModelStore {
     }
 
     fn send(&self, prepared: Box<Prepared>) {
-        // Models still waiting are stale now; drop them here, not on the audio thread.
+        // Models still waiting are stale now, and exact facts for the model replaced; drop
+        // them here, not on the audio thread.
         while self.to_audio.1.try_recv().is_ok() {}
+        while self.to_refine.1.try_recv().is_ok() {}
+        self.handed.fetch_add(1, Ordering::AcqRel);
         if self.to_audio.0.try_send(prepared).is_ok() {
             self.generation.fetch_add(1, Ordering::AcqRel);
         }
@@ -728,22 +776,20 @@ impl ModelStore {
 
     /// Compiles the running script for `sample_rate` at activation. When it cannot be
     /// compiled at this rate, the default preset runs instead and the diagnostics say why.
-    pub fn activate(&self, sample_rate: f64) -> Option<Box<Prepared>> {
+    /// `offline`: the host renders offline, and every model is prepared in full before it
+    /// plays, so that a bounce never depends on when a thread finished.
+    pub fn activate(self: &Arc<Self>, sample_rate: f64, offline: bool) -> Option<Box<Prepared>> {
         let _preparing = lock(&self.preparing);
         self.voices_stale.store(false, Ordering::Release);
         self.collect_garbage();
         while self.to_audio.1.try_recv().is_ok() {}
+        while self.to_refine.1.try_recv().is_ok() {}
+        self.offline.store(offline, Ordering::Release);
         self.sample_rate
             .store(sample_rate.to_bits(), Ordering::Release);
         let state = self.running();
         let voices = self.voices();
-        let prepared = prepare(
-            &state.name,
-            &state.script,
-            sample_rate,
-            voices,
-            state.playing,
-        );
+        let prepared = self.prepare_for_audio(&state, sample_rate, voices);
         let (prepared, reader) = match prepared {
             Ok(p) => p,
             Err(rejected) => {
@@ -770,6 +816,11 @@ impl ModelStore {
         status.stability_pending = true;
         drop(status);
         *lock(&self.motion) = Some(reader);
+        self.handed.fetch_add(1, Ordering::AcqRel);
+        if prepared.facts().provisional {
+            let state = self.running();
+            self.refine_in_background(state, sample_rate, voices, prepared.shared_facts());
+        }
         Some(Box::new(prepared))
     }
 
@@ -778,6 +829,7 @@ impl ModelStore {
         let _preparing = lock(&self.preparing);
         self.sample_rate.store(0, Ordering::Release);
         while self.to_audio.1.try_recv().is_ok() {}
+        while self.to_refine.1.try_recv().is_ok() {}
         self.collect_garbage();
     }
 
@@ -826,7 +878,7 @@ mod tests {
     /// An active store (48 kHz) running the default preset.
     fn active() -> Arc<ModelStore> {
         let store = Arc::new(ModelStore::default());
-        assert!(store.activate(48000.0).is_some());
+        assert!(store.activate(48000.0, true).is_some());
         store
     }
 

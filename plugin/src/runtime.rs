@@ -41,6 +41,8 @@ pub struct RuntimeStatus {
     pub input_peak: AtomicF64,
     /// Strikes the sidechain trigger has played.
     pub triggered: AtomicU32,
+    /// Provisional models that have taken their exact analyses ([`crate::model::Refinement`]).
+    pub refinements: AtomicU64,
 }
 
 impl Default for RuntimeStatus {
@@ -63,6 +65,7 @@ impl Default for RuntimeStatus {
             voices_total: AtomicU32::new(1),
             input_peak: AtomicF64::new(0.0),
             triggered: AtomicU32::new(0),
+            refinements: AtomicU64::new(0),
         }
     }
 }

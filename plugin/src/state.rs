@@ -235,7 +235,7 @@ mod tests {
         use crate::model::ModelState;
         use crate::presets::Preset;
         let store = Arc::new(ModelStore::default());
-        assert!(store.activate(48_000.0).is_some());
+        assert!(store.activate(48_000.0, true).is_some());
         let running = store.running();
         let p = Preset::find("harmonic-oscillator").expect("a preset");
         let other = ModelState::new(p.id, p.text);

@@ -133,7 +133,7 @@ mod tests {
         let store = Arc::new(ModelStore::default());
         let p = Preset::find(id).unwrap();
         store.submit(ModelState::new(p.id, p.text)).unwrap();
-        store.activate(48_000.0);
+        store.activate(48_000.0, true);
         store
     }
 

@@ -67,7 +67,7 @@ mod tests {
         let store = Arc::new(ModelStore::default());
         store.set_voices(1);
         let prepared = store
-            .activate(48_000.0)
+            .activate(48_000.0, true)
             .expect("the default model compiles");
         assert_eq!(prepared.voices(), 1);
         let generation = store.generation();
@@ -105,7 +105,7 @@ mod tests {
         let store = Arc::new(ModelStore::default());
         store.set_voices(1);
         store
-            .activate(48_000.0)
+            .activate(48_000.0, true)
             .expect("the default model compiles");
         store.set_voices(8);
         assert!(store.voices_stale());
@@ -128,7 +128,7 @@ mod tests {
     fn the_watch_never_brings_back_a_replaced_script() {
         let store = Arc::new(ModelStore::default());
         store
-            .activate(48_000.0)
+            .activate(48_000.0, true)
             .expect("the default model compiles");
         let watch = VoicesWatch::start(store.clone()).expect("a thread");
         for round in 0..40 {

@@ -178,7 +178,7 @@ fn macro_ranges_stop_where_the_model_would_explode() {
 
 #[test]
 fn a_bad_script_keeps_the_running_model_and_reports_where() {
-    let store = ModelStore::default();
+    let store = std::sync::Arc::new(ModelStore::default());
     let before = store.running();
     let err = store
         .submit(ModelState::new(
@@ -416,10 +416,12 @@ fn chladni_listening_point_is_a_macro_knob() {
 
 #[test]
 fn ab_compare_switches_between_two_scripts() {
-    let store = ModelStore::default();
+    let store = std::sync::Arc::new(ModelStore::default());
     let a = ModelState::new("a", "@o osc 1. 0.1 0.001 0. 0.\n@out1 posOutput @o\n");
     let b = ModelState::new("b", "@o osc 1. 0.2 0.001 0. 0.\n@out1 posOutput @o\n");
-    store.activate(48_000.0).expect("the default preset runs");
+    store
+        .activate(48_000.0, true)
+        .expect("the default preset runs");
     store.submit(a.clone()).unwrap();
     assert_eq!(store.compare().active, 0);
     // B starts as a copy of A.
@@ -449,8 +451,10 @@ fn ab_compare_switches_between_two_scripts() {
 /// for each of two models loaded one after the other without a look in between.
 #[test]
 fn the_stability_lines_follow_the_running_model() {
-    let store = ModelStore::default();
-    store.activate(48_000.0).expect("the default preset runs");
+    let store = std::sync::Arc::new(ModelStore::default());
+    store
+        .activate(48_000.0, true)
+        .expect("the default preset runs");
     for (name, mass) in [("mesh-15x15", "@mesh["), ("string-1000", "@s[")] {
         let preset = Preset::find(name).unwrap();
         store

@@ -47,6 +47,7 @@ use clack_extensions::preset_discovery::HostPresetLoadImpl;
 use clack_extensions::remote_controls::{
     HostRemoteControls, HostRemoteControlsImpl, PluginRemoteControls, RemoteControlsPageBuffer,
 };
+use clack_extensions::render::{PluginRender, RenderMode};
 use clack_extensions::state::{HostState, HostStateImpl, PluginState, StateError};
 use clack_extensions::thread_check::{HostThreadCheck, HostThreadCheckImpl};
 use clack_host::events::event_types::{

@@ -14,6 +14,7 @@ pub(crate) struct Extensions {
     gui: Option<PluginGui>,
     remote_controls: Option<PluginRemoteControls>,
     preset_load: Option<PluginPresetLoad>,
+    render: Option<PluginRender>,
 }
 
 /// A CLAP remote-controls page as the host reads it.
@@ -67,9 +68,20 @@ impl Default for TestPlugin {
 }
 
 impl TestPlugin {
-    /// Loads the bundle and creates an instance. The calling thread becomes the instance's
-    /// main thread (and its audio thread during audio calls).
+    /// Loads the bundle and creates an instance that renders offline (CLAP render extension),
+    /// as a DAW bouncing a project: every model it loads is prepared in full before it plays,
+    /// so that a render never depends on a background thread's timing. The calling thread
+    /// becomes the instance's main thread (and its audio thread during audio calls).
     pub fn new() -> TestPlugin {
+        let mut plugin = TestPlugin::realtime();
+        plugin.set_offline(true);
+        plugin
+    }
+
+    /// [`TestPlugin::new`] in the render mode of a DAW playing live (the CLAP default): a
+    /// script whose analyses are not kept plays at once on provisional facts, and the exact
+    /// ones follow from a thread of the plugin.
+    pub fn realtime() -> TestPlugin {
         ROLE.with(|r| r.set(Role::Main));
         let entry = load_entry();
         let info = crate::host_info();
@@ -103,6 +115,7 @@ impl TestPlugin {
             gui: shared.get_extension(),
             remote_controls: shared.get_extension(),
             preset_load: shared.get_extension(),
+            render: shared.get_extension(),
         };
         let mut plugin = TestPlugin {
             processor: None,
@@ -114,6 +127,22 @@ impl TestPlugin {
         };
         plugin.idle();
         plugin
+    }
+
+    /// Sets the render mode (CLAP render extension): offline or realtime. While active, the
+    /// plugin asks for a restart, which the next [`TestPlugin::idle`] performs.
+    pub fn set_offline(&mut self, offline: bool) {
+        let render = self.ext.render.expect("the plugin has no render extension");
+        let mode = if offline {
+            RenderMode::Offline
+        } else {
+            RenderMode::Realtime
+        };
+        let handle = self.instance.plugin_handle();
+        render
+            .set(&handle, mode)
+            .unwrap_or_else(|e| panic!("render.set({mode:?}): {e}"));
+        self.idle();
     }
 
     /// Opens the plugin's editor embedded in the X11 window `parent` (CLAP gui extension:

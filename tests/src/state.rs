@@ -10,6 +10,28 @@ pub fn json(blob: &[u8]) -> Option<Value> {
     serde_json::from_slice(blob.get(8..8 + len)?).ok()
 }
 
+/// The state's JSON with the model's kept analyses left out: in a realtime host a state saved
+/// before a new script's exact analyses finished has none, and one saved after has them; both
+/// are the same project.
+pub fn json_without_analyses(blob: &[u8]) -> Option<Value> {
+    let mut v = json(blob)?;
+    let field = v.get("fields")?.get("model")?.as_str()?;
+    let mut m: Value = serde_json::from_str(field).ok()?;
+    m.as_object_mut()?.remove("analyses");
+    *v.get_mut("fields")?.get_mut("model")? = Value::String(m.to_string());
+    Some(v)
+}
+
+/// Whether the state's model carries analyses (the process kept them for its script).
+pub fn has_analyses(blob: &[u8]) -> bool {
+    json(blob)
+        .and_then(|v| {
+            let field = v.get("fields")?.get("model")?.as_str()?.to_string();
+            serde_json::from_str::<Value>(&field).ok()
+        })
+        .is_some_and(|m| m.get("analyses").is_some())
+}
+
 /// A state blob around JSON bytes (the length prefix added).
 pub fn blob(json: &[u8]) -> Vec<u8> {
     let mut out = (json.len() as u64).to_le_bytes().to_vec();

@@ -275,7 +275,26 @@ fn analyze(e: &Engine, labelled: bool) -> StabilityReport {
             z_eq[node] += w * z;
         }
     };
+    // A link between two material points of a 1-D model (no connection point) takes the
+    // arithmetic of `add` and `couple` with weight 1 directly: the same operations in the same
+    // order, so the same bits, without the endpoints' generality, which costs most of the time
+    // on a large mesh (a provisional model's envelopes, instrument::prepare).
+    let plain = e.space.is_none();
+    let weight = |p: usize| -> f64 { is_moving(p).then_some(1.0).into_iter().sum() };
     for l in &net.links {
+        let (a, b) = (l.a as usize, l.b as usize);
+        if plain && a < n && b < n {
+            k_eq[a] += 1.0 * l.k;
+            z_eq[a] += 1.0 * l.z;
+            k_eq[b] += 1.0 * l.k;
+            z_eq[b] += 1.0 * l.z;
+            let (towards_b, towards_a) = (weight(b), weight(a));
+            k_cp[a] += l.k * towards_b;
+            z_cp[a] += l.z * towards_b;
+            k_cp[b] += l.k * towards_a;
+            z_cp[b] += l.z * towards_a;
+            continue;
+        }
         add(l.a, l.k, l.z, &mut k_eq, &mut z_eq);
         add(l.b, l.k, l.z, &mut k_eq, &mut z_eq);
         couple(l.a, l.b, l.k, l.z, &mut k_cp, &mut z_cp);

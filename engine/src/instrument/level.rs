@@ -64,16 +64,47 @@ const INPUT_TRIM_RANGE: (f64, f64) = (1e-5, 1e3);
 /// Below this the model counts as silent.
 const SILENT: f64 = 1e-12;
 
+/// Element-steps the renders of a provisional model's levels ([`calibrate_quick`]) may take:
+/// some 20 ms of simulation on this machine's slowest path.
+pub const QUICK_WORK_BUDGET: f64 = 1e7;
+/// How much quieter than its shortened note render asks a provisional model plays when the
+/// render was cut short: the peak may come later and higher (a bow builds up over a second),
+/// and a level that rises when the exact analyses arrive is better than one that hits the
+/// ceiling before.
+pub const QUICK_SHORT_MARGIN_DB: f64 = 12.0;
+
 /// Measures the model's rest outputs, note level and drum level, and sets its trims.
 pub fn calibrate(p: Prepared) -> Prepared {
+    calibrate_within(p, WORK_BUDGET, true)
+}
+
+/// [`calibrate`] within [`QUICK_WORK_BUDGET`], without the drum's correcting renders and
+/// without the note's floor of [`NOTE_MIN_SECONDS`]: the levels a provisional model plays
+/// at until its exact analyses are done ([`super::load::prepare_provisional`]). A render cut
+/// short errs on the quiet side by [`QUICK_SHORT_MARGIN_DB`]; a model too large for even a
+/// few samples measures silent and keeps 0 dB.
+pub fn calibrate_quick(p: Prepared) -> Prepared {
+    calibrate_within(p, QUICK_WORK_BUDGET, false)
+}
+
+fn calibrate_within(p: Prepared, work_budget: f64, full: bool) -> Prepared {
     let mut p = p;
     p.facts_mut().rest_out = rest_outputs(&mut p);
     let size = (p.engine.info().num_points + p.engine.info().num_interactions).max(1) as f64;
-    let budget = (WORK_BUDGET / size).max(1.0);
+    let budget = (work_budget / size).max(1.0);
     let sr = p.facts.sample_rate;
-    let note_frames = (SECONDS * sr).min(budget.max(NOTE_MIN_SECONDS * sr)) as usize;
+    let (note_floor, drum_floor) = if full {
+        (NOTE_MIN_SECONDS * sr, 0.25 * sr)
+    } else {
+        (0.0, 0.0)
+    };
+    let note_frames = (SECONDS * sr).min(budget.max(note_floor)) as usize;
+    // Shorter than the full calibration's render (only a quick one can be).
+    let full_frames =
+        (SECONDS * sr).min((WORK_BUDGET / size).max(1.0).max(NOTE_MIN_SECONDS * sr)) as usize;
+    let short = note_frames < full_frames;
     // A kick lasts about 0.3 s: its window is not shortened below a quarter second.
-    let drum_frames = (DRUM_SECONDS * sr).min(budget.max(0.25 * sr)) as usize;
+    let drum_frames = ((DRUM_SECONDS * sr).min(budget.max(drum_floor)) as usize).max(1);
     let (p1, note) = peak(p, note_frames, true, None);
     // The drum, when the sidechain pushes a force input.
     // Played on every channel that feeds the model (a drum on a stereo sidechain moves its
@@ -86,7 +117,11 @@ pub fn calibrate(p: Prepared) -> Prepared {
     } else {
         (p1, 0.0)
     };
-    let target = 10f64.powf(TARGET_DBFS / 20.0);
+    let target = if short {
+        10f64.powf((TARGET_DBFS - QUICK_SHORT_MARGIN_DB) / 20.0)
+    } else {
+        10f64.powf(TARGET_DBFS / 20.0)
+    };
     let (output, input) = if note > SILENT {
         (target / note, if drum > SILENT { note / drum } else { 1.0 })
     } else if drum > SILENT {
@@ -96,7 +131,7 @@ pub fn calibrate(p: Prepared) -> Prepared {
     };
     p3.facts_mut().output_trim = output.clamp(OUTPUT_TRIM_RANGE.0, OUTPUT_TRIM_RANGE.1);
     p3.facts_mut().input_trim = input.clamp(INPUT_TRIM_RANGE.0, INPUT_TRIM_RANGE.1);
-    if note > SILENT && drum > SILENT {
+    if full && note > SILENT && drum > SILENT {
         p3 = refine_input_trim(p3, note, drum_frames, mask);
     }
     p3

@@ -6,7 +6,7 @@
 
 use super::analyses::{self, Analyses};
 use super::host::Rejected;
-use super::level::calibrate;
+use super::level::{calibrate, calibrate_quick};
 use super::prepare::{prepare_uncalibrated, Conventions, Prepared, Source, UNITS_BUDGET_S};
 
 /// Compiles a script for a sample rate and derives everything the audio thread needs.
@@ -80,6 +80,34 @@ pub fn prepare_analysed_at_pitch(
         },
     )?;
     Ok(finish(prepared, conventions))
+}
+
+/// Whether [`prepare_with`] would take kept analyses for the script (the shipped table, the
+/// process's memory, a project's saved ones) and so prepare it in milliseconds.
+pub fn analyses_kept(text: &str, sample_rate: f64, conventions: Conventions) -> bool {
+    analyses::recall(text, sample_rate, conventions).is_some()
+}
+
+/// A model that plays at once, for a script whose analyses are not kept: compiled as
+/// [`prepare_with`] compiles it, with the quick stand-ins of [`Source::Provisional`] for its
+/// analyses (the Gershgorin envelope, a short impulse response's pitch or none, values for
+/// the macro units) and levels from shortened renders ([`calibrate_quick`]). Its facts say
+/// [`super::Facts::provisional`]; nothing is kept for the script. The exact analyses come from
+/// [`prepare_with`] on another thread, and [`super::Instrument::refine`] hands their facts to
+/// the playing model. A milliseconds' matter where the full preparation takes up to seconds
+/// (`cargo run --release -p ressort-engine --example first_sound`).
+pub fn prepare_provisional(
+    name: &str,
+    text: &str,
+    sample_rate: f64,
+    conventions: Conventions,
+) -> Result<Prepared, Rejected> {
+    let (prepared, _) =
+        prepare_uncalibrated(name, text, sample_rate, conventions, Source::Provisional)?;
+    Ok(match conventions {
+        Conventions::Musical => calibrate_quick(prepared),
+        Conventions::Legacy => prepared,
+    })
 }
 
 /// The level calibration of a freshly analysed model (legacy projects have none).

@@ -35,6 +35,7 @@ pub mod meshes;
 pub mod output;
 pub mod pitch;
 pub mod prepare;
+mod refine;
 pub mod saved_analyses;
 pub mod trigger;
 pub mod units;
@@ -47,7 +48,10 @@ pub use controls::Controls;
 pub use events::{Event, Timed};
 pub use gains::Gains;
 pub use host::{HostSettings, InputRole, Rejected};
-pub use load::{prepare, prepare_analysed, prepare_analysed_at_pitch, prepare_with};
+pub use load::{
+    analyses_kept, prepare, prepare_analysed, prepare_analysed_at_pitch, prepare_provisional,
+    prepare_with,
+};
 pub use macros::MacroBinding;
 pub use prepare::{
     parse_script, peak_frequency, Conventions, Facts, Prepared, Watcher, PLACE_GLIDE_MS,
@@ -174,6 +178,9 @@ pub struct Instrument {
     shared_gains: SharedGains,
     /// Output gain where the current chunk's per-sample ramp starts.
     last_output_gain: f64,
+    /// The glide of a provisional model's levels to its exact trims ([`Instrument::refine`]);
+    /// exactly 1 otherwise.
+    settle: refine::Settle,
     /// Length of the current chunk and the samples of it already rendered. A chunk runs to
     /// the next multiple of CHUNK (counted from the start, or from the host's song position;
     /// see [`Instrument::set_song_position`]), so the sound does not depend on the host's
@@ -193,6 +200,10 @@ pub struct Instrument {
     /// The one model's own note tuning (semitones) and pressure (0 … 1); with voices, the
     /// pressure that reaches the model itself (channel pressure without MPE).
     tuning_st: f64,
+    /// What keeps the one model's sounding note at its pitch when its exact analyses move its
+    /// reference key ([`Instrument::refine`]): the keys' move, in semitones, until the next
+    /// note or model.
+    kept_st: f64,
     pressure: f64,
     /// With MPE, each member channel's last bend (semitones) and pressure: a note takes its
     /// channel's values when it starts (controllers send them before the note-on).
@@ -229,6 +240,7 @@ impl Instrument {
             current_silent: false,
             controls,
             last_output_gain: smoothed.output_gain.value,
+            settle: refine::Settle::new(sample_rate),
             smoothed,
             gains: Gains::default(),
             shared_gains: SharedGains::new(),
@@ -240,6 +252,7 @@ impl Instrument {
             note_key: None,
             bend_st: 0.0,
             tuning_st: 0.0,
+            kept_st: 0.0,
             pressure: 0.0,
             channel_bend: [0.0; 16],
             channel_pressure: [0.0; 16],
@@ -307,6 +320,8 @@ impl Instrument {
     /// nothing). Returns a model to free off the audio thread: the one that was still fading
     /// out, or the silent one replaced. Realtime-safe.
     pub fn set_model(&mut self, model: Box<Prepared>) -> Option<Box<Prepared>> {
+        self.kept_st = 0.0;
+        self.settle = refine::Settle::new(self.sample_rate);
         if self.current_silent {
             // The new model fades in from the silence over the same 20 ms, alone; a fade
             // still running (towards the silent model) goes on towards the new one.
@@ -360,6 +375,7 @@ impl Instrument {
         self.note_key = None;
         self.bend_st = 0.0;
         self.tuning_st = 0.0;
+        self.kept_st = 0.0;
         self.pressure = 0.0;
         self.channel_bend = [0.0; 16];
         self.channel_pressure = [0.0; 16];
@@ -367,6 +383,7 @@ impl Instrument {
         self.host_macros = self.controls.macros;
         self.cc_macros = [None; NUM_MACROS];
         self.smoothed = Smoothed::snapped(&self.controls, self.sample_rate);
+        self.settle = refine::Settle::new(self.sample_rate);
         self.last_output_gain = self.smoothed.output_gain.value;
         self.output = OutputStage::new(self.sample_rate);
         self.counter = 0;
@@ -401,7 +418,9 @@ impl Instrument {
         let Some(bank) = m.bank.as_mut() else {
             let key = self.note_key.map_or(m.home_key(), f64::from);
             let note_st = key - m.facts.settings.reference_key;
-            self.gains = self.smoothed.apply(m, note_st + self.tuning_st);
+            self.gains = self
+                .smoothed
+                .apply(m, note_st + self.tuning_st + self.kept_st);
             return;
         };
         let view = clamp_view!(m);
@@ -453,7 +472,7 @@ impl Instrument {
     /// the grid point both chunks run to.
     fn start_chunk(&mut self, advance: bool) {
         // The next ramp starts where this one got to: its end, or where a cut left it.
-        let g1 = self.smoothed.output_gain.value;
+        let g1 = self.smoothed.output_gain.value * self.settle.output.value;
         if self.chunk_done >= self.chunk_len {
             self.last_output_gain = g1;
         } else {
@@ -465,6 +484,7 @@ impl Instrument {
         if advance {
             self.smoothed
                 .advance(self.chunk_len, &self.controls, self.bend_st);
+            self.settle.advance(self.chunk_len);
         }
         self.apply();
     }
@@ -586,6 +606,7 @@ impl Instrument {
                                 self.apply_voice(i);
                             } else {
                                 self.note_key = Some(note);
+                                self.kept_st = 0.0;
                                 retuned = true;
                                 strike += response;
                                 // The one model's exciters follow the newest key.
@@ -724,8 +745,8 @@ impl Instrument {
                 report.loudest = report.loudest.max(d.abs());
             }
         }
-        let force = self.smoothed.force_gain.value;
-        let position = self.smoothed.position_gain.value;
+        let force = self.smoothed.force_gain.value * self.settle.input.value;
+        let position = self.smoothed.position_gain.value * self.settle.input.value;
         let trigger = self.controls.trigger;
         let mut tripped = false;
         if let Some(m) = self.current.as_deref_mut() {
@@ -842,7 +863,7 @@ impl Instrument {
         let span = Span {
             len,
             g0: self.last_output_gain,
-            g1: self.smoothed.output_gain.value,
+            g1: self.smoothed.output_gain.value * self.settle.output.value,
             done: self.chunk_done,
             chunk_len: self.chunk_len,
             dc_on: self.controls.dc_filter,

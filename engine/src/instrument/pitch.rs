@@ -176,6 +176,8 @@ pub(crate) fn reference_pitch(
 /// Work budget of the pitch estimate, in element-steps: small models get a long window,
 /// models too large for it get none (the tuning law then uses its low-frequency limit).
 const PITCH_BUDGET: f64 = 4e7;
+/// The budget of [`quick_pitch`]: some 10 ms of simulation on this machine's slowest path.
+const QUICK_PITCH_BUDGET: f64 = 4e6;
 /// Length of the pitch estimate's impulse response.
 const PITCH_WINDOW: usize = 8192;
 
@@ -188,13 +190,35 @@ fn estimate_pitch(
     note_input: Option<usize>,
     roles: &[InputRole],
 ) -> Option<f64> {
+    impulse_pitch(engine, note_input, roles, PITCH_BUDGET)
+}
+
+/// The provisional reference pitch a model plays with while its exact analyses run
+/// ([`super::prepare::Source::Provisional`]): the impulse response's peak within
+/// [`QUICK_PITCH_BUDGET`], so for models of up to about 500 elements; None above, where the
+/// key plays the model's own pitch at its `~key` until the analysed pitch arrives.
+pub(crate) fn quick_pitch(
+    engine: &mut Engine,
+    note_input: Option<usize>,
+    roles: &[InputRole],
+) -> Option<f64> {
+    impulse_pitch(engine, note_input, roles, QUICK_PITCH_BUDGET)
+}
+
+/// [`estimate_pitch`] within `budget` element-steps.
+fn impulse_pitch(
+    engine: &mut Engine,
+    note_input: Option<usize>,
+    roles: &[InputRole],
+    budget: f64,
+) -> Option<f64> {
     let k = note_input?;
     let info = engine.info();
     if info.num_outputs() == 0 {
         return None;
     }
     let size = (info.num_points + info.num_interactions).max(1) as f64;
-    if size * PITCH_WINDOW as f64 > PITCH_BUDGET {
+    if size * PITCH_WINDOW as f64 > budget {
         return None;
     }
     let sr = engine.sample_rate_hz();

@@ -8,7 +8,7 @@ use super::exciters::{self, Exciter, Gestures};
 use super::host::{HostSettings, InputRole, Rejected};
 use super::macros::{macro_bindings, MacroBinding};
 pub use super::pitch::{concert_key, peak_frequency, reference_mode};
-use super::pitch::{musical_reference_pitch, reference_pitch, settle_pitch};
+use super::pitch::{musical_reference_pitch, quick_pitch, reference_pitch, settle_pitch};
 use super::units::{unit_of, MacroUnit};
 use super::voices::VoiceBank;
 use super::CHUNK;
@@ -91,6 +91,9 @@ pub struct Facts {
     /// connection-point coordinate (an `audioParam` named in `[@s f]`, [`PLACE_GLIDE_MS`]),
     /// 1 for every other input, which takes the signal as it comes.
     pub place_glide: Vec<f64>,
+    /// The analyses' part holds quick stand-ins ([`Source::Provisional`]): the exact
+    /// analyses are still to come, and [`super::Instrument::refine`] takes them when they do.
+    pub provisional: bool,
 }
 
 /// The time constant with which a host signal moves a connection point along its macro.
@@ -207,6 +210,11 @@ pub(crate) enum Source {
     /// Kept from an earlier preparation of the same script ([`super::analyses`]); a result
     /// that does not fit the compiled script (a stale table) is analysed afresh.
     Known(Arc<Analyses>),
+    /// The quick, conservative stand-ins a model plays on until its exact analyses are done
+    /// ([`super::load::prepare_provisional`]): the Gershgorin envelope instead of the exact
+    /// one, a short impulse response's peak (or the declared `~pitch`) instead of the modal
+    /// reference pitch, and every macro slot read as its value.
+    Provisional,
 }
 
 /// Compiles a script for a sample rate and derives everything the audio thread needs, under
@@ -274,9 +282,14 @@ pub(crate) fn prepare_uncalibrated(
     {
         settings.reference_pitch_hz = Some(pitch);
     }
-    let found = match source {
-        Source::Known(ref kept) => (**kept).clone(),
-        Source::Analyse { units_budget_s, .. } => analyse(
+    let found = if let Source::Known(ref kept) = source {
+        (**kept).clone()
+    } else {
+        let depth = match source {
+            Source::Analyse { units_budget_s, .. } => Depth::Exact { units_budget_s },
+            _ => Depth::Provisional,
+        };
+        analyse(
             &spec,
             &mut engine,
             &mut settings,
@@ -284,8 +297,8 @@ pub(crate) fn prepare_uncalibrated(
             note_input,
             &exciters,
             &roles,
-            units_budget_s,
-        ),
+            depth,
+        )
     };
     let rate = match spec.sample_rate_mode {
         SampleRateMode::Scaled => REFERENCE_SAMPLE_RATE_HZ / sample_rate,
@@ -298,6 +311,7 @@ pub(crate) fn prepare_uncalibrated(
         Conventions::Legacy => vec![1.0; info.inputs.len()],
     };
     let mut facts = Facts {
+        provisional: false,
         place_glide,
         exciters,
         conventions,
@@ -321,7 +335,8 @@ pub(crate) fn prepare_uncalibrated(
         name: name.to_string(),
         roles,
     };
-    let fresh = matches!(source, Source::Analyse { .. });
+    let fresh = !matches!(source, Source::Known(_));
+    facts.provisional = matches!(source, Source::Provisional);
     if !fresh && !found.fits(&facts, &engine) {
         return prepare_uncalibrated(
             name,
@@ -351,10 +366,20 @@ pub(crate) fn prepare_uncalibrated(
     Ok((prepared, source))
 }
 
-/// Runs the analyses of a freshly compiled model ([`Source::Analyse`]): the reference pitch
-/// (which also sets `settings`' reference pitch and key), the stability envelopes, the worst
-/// load and the macro units. The rests and trims are left at their neutral values for the
-/// level calibration. Leaves the engine's parameters as it found them.
+/// How far [`analyse`] goes.
+#[derive(Clone, Copy, Debug)]
+enum Depth {
+    /// Every analysis, the macro units measured for at most this long.
+    Exact { units_budget_s: f64 },
+    /// Only what takes milliseconds on the largest models ([`Source::Provisional`]).
+    Provisional,
+}
+
+/// Runs the analyses of a freshly compiled model ([`Source::Analyse`], or their quick
+/// stand-ins for [`Source::Provisional`]): the reference pitch (which also sets `settings`'
+/// reference pitch and key), the stability envelopes, the worst load and the macro units.
+/// The rests and trims are left at their neutral values for the level calibration. Leaves
+/// the engine's parameters as it found them.
 #[allow(clippy::too_many_arguments)]
 fn analyse(
     spec: &ModelSpec,
@@ -364,13 +389,14 @@ fn analyse(
     note_input: Option<usize>,
     exciters: &[Exciter],
     roles: &[InputRole],
-    units_budget_s: f64,
+    depth: Depth,
 ) -> Analyses {
     let sample_rate = engine.sample_rate_hz();
     if settings.reference_pitch_hz.is_none() {
-        settings.reference_pitch_hz = match conventions {
-            Conventions::Legacy => reference_pitch(engine, note_input, roles),
-            Conventions::Musical => {
+        settings.reference_pitch_hz = match (depth, conventions) {
+            (Depth::Provisional, _) => quick_pitch(engine, note_input, roles),
+            (_, Conventions::Legacy) => reference_pitch(engine, note_input, roles),
+            (_, Conventions::Musical) => {
                 musical_reference_pitch(spec, engine, note_input, exciters, roles, sample_rate)
             }
         }
@@ -396,15 +422,27 @@ fn analyse(
     // A model the exact criterion rejects as written (a script written at the edge for
     // 44.1 kHz, played at 22.05 kHz) would explode: the Gershgorin envelope is not scaled to
     // trust it then, so that the macro envelopes stay true bounds.
-    let exact = engine.exact_stability();
-    let gershgorin = if exact.is_stable(1.0, 1.0) == Some(false) {
-        raw_envelope(engine)
-    } else {
-        envelope(engine)
+    let (envelope, gershgorin) = match depth {
+        Depth::Exact { .. } => {
+            let exact = engine.exact_stability();
+            let gershgorin = if exact.is_stable(1.0, 1.0) == Some(false) {
+                raw_envelope(engine)
+            } else {
+                envelope(engine)
+            };
+            let envelope = exact_envelope(&exact).unwrap_or_else(|| gershgorin.clone());
+            // Its matrices are not needed past here.
+            drop(exact);
+            (envelope, gershgorin)
+        }
+        // The Gershgorin envelope, trusting the script as written as it does where the exact
+        // criterion does not apply; a script the exact analysis rejects as written (a 44.1 kHz
+        // edge played at 22.05 kHz) is held by the guard until the exact limits arrive.
+        Depth::Provisional => {
+            let gershgorin = envelope(engine);
+            (gershgorin.clone(), gershgorin)
+        }
     };
-    let envelope = exact_envelope(&exact).unwrap_or_else(|| gershgorin.clone());
-    // Its matrices are not needed past here.
-    drop(exact);
     let report = engine.stability();
     let worst_load = worst_load(&report);
     let macros = macro_bindings(engine, settings);
@@ -427,6 +465,11 @@ fn analyse(
         let _ = engine.set_param(id, value);
     }
     engine.apply_pending_changes();
+    let units_budget_s = match depth {
+        Depth::Exact { units_budget_s } => units_budget_s,
+        // Nothing measured: every slot reads as its value.
+        Depth::Provisional => f64::NEG_INFINITY,
+    };
     let macro_units = macro_units(engine, &macros, note_input, units_budget_s);
 
     Analyses {
@@ -549,6 +592,12 @@ impl Prepared {
     /// What preparing the model found.
     pub fn facts(&self) -> &Facts {
         &self.facts
+    }
+
+    /// The facts as shared: what [`super::Instrument::refine`] recognises a provisional model
+    /// by (the same `Arc`). Off the audio thread.
+    pub fn shared_facts(&self) -> Arc<Facts> {
+        Arc::clone(&self.facts)
     }
 
     /// The facts while the model is being prepared (the level calibration writes its trims).

@@ -269,7 +269,7 @@ mod tests {
                 Preset::find("mesh-15x15").unwrap().text,
             ))
             .unwrap();
-        store.activate(48_000.0);
+        store.activate(48_000.0, true);
         let params = Arc::new(RessortParams::new(store.clone()));
         let mut app = EditorApp::new(params, store.clone());
         app.filter.category = Some("Strings / Bowed");
