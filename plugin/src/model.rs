@@ -149,16 +149,11 @@ fn with_voices_and_motion(
     sample_rate: f64,
     voices: usize,
 ) -> (Prepared, MotionReader) {
-    set_voices(&mut prepared, voices);
+    let declared = prepared.facts().settings.voices.unwrap_or(1) as usize;
+    prepared.set_voices(if voices == 0 { declared } else { voices });
     let (writer, reader) = motion_channel(&prepared.engine, sample_rate);
     prepared.watcher = Some(Box::new(writer));
     (prepared, reader)
-}
-
-/// Gives a prepared model its voices: `voices` as [`prepare`] takes it.
-fn set_voices(prepared: &mut Prepared, voices: usize) {
-    let declared = prepared.facts().settings.voices.unwrap_or(1) as usize;
-    prepared.set_voices(if voices == 0 { declared } else { voices });
 }
 
 /// A model's description for the editor and the tests: counts and analysis, made when it
@@ -614,9 +609,12 @@ impl ModelStore {
                     status.stability_pending = true;
                     drop(status);
                     *lock(&self.motion) = Some(reader);
-                    let provisional = p.facts().provisional.then(|| p.shared_facts());
+                    let provisional = p
+                        .facts()
+                        .provisional
+                        .then(|| (p.shared_facts(), p.voices()));
                     self.send(Box::new(p));
-                    if let Some(facts) = provisional {
+                    if let Some((facts, voices)) = provisional {
                         self.refine_in_background(state.clone(), rate, voices, facts);
                     }
                 }
@@ -819,6 +817,7 @@ impl ModelStore {
         self.handed.fetch_add(1, Ordering::AcqRel);
         if prepared.facts().provisional {
             let state = self.running();
+            let voices = prepared.voices();
             self.refine_in_background(state, sample_rate, voices, prepared.shared_facts());
         }
         Some(Box::new(prepared))

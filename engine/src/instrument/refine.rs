@@ -5,7 +5,7 @@
 //! levels from shortened renders) while [`super::prepare_with`] runs the exact analyses on
 //! another thread. Their facts replace the stand-ins in the running model at a chunk boundary,
 //! without restarting it: the notes sounding go on. What the swap would otherwise change in a
-//! step is ramped through the controls' own smoothers:
+//! step is carried over:
 //!
 //! * **Output and input trims.** A factor of their own ([`Settle`]) takes old trim / new trim
 //!   at the swap, so the product the audio hears is continuous, and glides to 1 with the time

@@ -14,7 +14,7 @@
 //! An offline host (CLAP render mode, VST3 `kOffline`) waits for the exact analyses instead:
 //! a bounce must not depend on when a thread finished.
 
-use super::{lock, set_voices, summary, with_voices_and_motion, ModelState, ModelStore};
+use super::{lock, summary, with_voices_and_motion, ModelState, ModelStore};
 use super::{prepare, Facts, MotionReader, Prepared, Rejected};
 use ressort_engine::instrument::{self, ModalModel};
 use std::sync::atomic::Ordering;
@@ -51,9 +51,9 @@ impl ModelStore {
         Ok(with_voices_and_motion(quick, rate, voices))
     }
 
-    /// Runs the exact analyses of a model handed to the audio thread on provisional facts, on
-    /// a thread of its own (one at a time), and sends their facts after it; the summary and
-    /// the modal copy follow them. Skipped when the model is replaced before they are done (a
+    /// Runs the exact analyses of a model handed to the audio thread on provisional facts
+    /// (`voices` its voice count), on a thread of its own (one at a time), and sends their facts
+    /// after it; the summary and the modal copy follow them. Skipped when the model is replaced before they are done (a
     /// newer model, a deactivation): they are kept for the script either way, so that its
     /// next load takes them.
     pub(super) fn refine_in_background(
@@ -89,12 +89,13 @@ impl ModelStore {
             return;
         }
         let conventions = state.playing.conventions();
-        let Ok(mut exact) = instrument::prepare_with(&state.name, &state.script, rate, conventions)
+        let Ok(exact) = instrument::prepare_with(&state.name, &state.script, rate, conventions)
         else {
             return;
         };
-        set_voices(&mut exact, voices);
-        let new_summary = summary(&exact);
+        // Only the facts go to the audio thread: the playing model keeps its voices.
+        let mut new_summary = summary(&exact);
+        new_summary.voices = voices;
         let modal = Arc::new(ModalModel::of(&exact));
         let facts = exact.shared_facts();
         drop(exact);
